@@ -1,0 +1,395 @@
+"""The common frame, conversions to each paper's own angles, and the derived angles.
+
+Common frame (MODELS.md §1.1, the only one used inside roughbrdf)
+-----------------------------------------------------------------
+* mean-surface normal ``+z``; plane of incidence x-z; the source on the ``-x`` side;
+* ``theta_i`` incidence zenith, ``theta_r`` reflection zenith, ``phi`` azimuth of the reflected
+  ray with ``phi = 0`` on the forward (specular) side and ``phi = pi`` on the source (retro) side;
+* unit vectors, both pointing away from the surface::
+
+      w_i = (-sin theta_i, 0, cos theta_i)
+      w_r = (sin theta_r cos phi, sin theta_r sin phi, cos theta_r)
+
+* half vector ``h = (w_i + w_r)/|w_i + w_r|``, ``|w_i + w_r| = 2 cos theta_d``;
+  ``theta_h`` is the facet-normal zenith, ``theta_d`` the local angle of incidence on the facet.
+
+All angles are radians. Each paper's convention is reached only through the functions here:
+
+==========  ==========================  ======================================================
+paper       its angles                  functions
+==========  ==========================  ======================================================
+TS67        (psi, theta, phi)           :func:`from_ts67`, :func:`to_ts67` (same as common)
+TR75        (beta, elevation, psi_TR)   :func:`from_tr75`, :func:`to_tr75` (psi_TR = pi - phi)
+RB08        (alpha, beta, alpha0)       :func:`from_rb08`, :func:`to_rb08` (direction cosines)
+MERL        (theta_h, theta_d, phi_d)   :func:`from_rusinkiewicz`, :func:`to_rusinkiewicz`
+==========  ==========================  ======================================================
+
+The scalar functions (``half_vector``, ``ts67_projected``, ``tr75_eta_from_h``) are Numba
+parts used inside every model kernel; the ufuncs of the same names without the suffix are their
+NumPy front ends.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ._jit import as_float_array, jit, ufunc
+
+HALF_PI = 0.5 * math.pi
+
+__all__ = [
+    "check_angles",
+    "check_zenith",
+    "unit_vectors",
+    "angles_from_vectors",
+    "half_vector",
+    "theta_h",
+    "theta_d",
+    "phi_h",
+    "ts67_projected",
+    "ts67_psi_p",
+    "ts67_theta_p",
+    "tr75_eta",
+    "from_ts67",
+    "to_ts67",
+    "from_tr75",
+    "to_tr75",
+    "from_rb08",
+    "to_rb08",
+    "from_rusinkiewicz",
+    "to_rusinkiewicz",
+    "signed_angle",
+    "from_signed_angle",
+]
+
+
+# --------------------------------------------------------------------------------------------
+# validation
+# --------------------------------------------------------------------------------------------
+def check_zenith(x: ArrayLike, name: str, *, open_upper: bool = False) -> np.ndarray:
+    """Return ``x`` as a float array after checking it is a zenith angle in [0, pi/2] radians.
+
+    Raises
+    ------
+    ValueError
+        If any value is NaN/inf or outside ``[0, pi/2]`` (``[0, pi/2)`` with ``open_upper``);
+        the message names ``name`` and the first offending value.
+    """
+    arr = as_float_array(x, name)
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        raise ValueError(f"{name} must be finite, got {arr[bad].flat[0]!r}")
+    upper = arr >= HALF_PI if open_upper else arr > HALF_PI
+    bad = (arr < 0.0) | upper
+    if bad.any():
+        v = float(arr[bad].flat[0])
+        rng = "[0, pi/2)" if open_upper else "[0, pi/2]"
+        raise ValueError(
+            f"{name} must be in {rng} radians, got {v!r} ({math.degrees(v):.6g} deg)"
+            + (" (the model divides by its cosine)" if open_upper and v == HALF_PI else "")
+        )
+    return arr
+
+
+def check_angles(
+    theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike, *, grazing_incidence: bool = True
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Validate and convert a (theta_i, theta_r, phi) triple of the common frame.
+
+    ``grazing_incidence=False`` rejects ``theta_i = pi/2`` for models that divide by
+    ``cos theta_i``. ``phi`` may be any finite angle (it is periodic).
+    """
+    ti = check_zenith(theta_i, "theta_i", open_upper=not grazing_incidence)
+    tr = check_zenith(theta_r, "theta_r")
+    ph = as_float_array(phi, "phi")
+    bad = ~np.isfinite(ph)
+    if bad.any():
+        raise ValueError(f"phi must be finite, got {ph[bad].flat[0]!r}")
+    np.broadcast_shapes(ti.shape, tr.shape, ph.shape)  # raises a clear NumPy error if not
+    return ti, tr, ph
+
+
+# --------------------------------------------------------------------------------------------
+# scalar parts (compiled)
+# --------------------------------------------------------------------------------------------
+@jit
+def half_vector(ti, tr, phi):
+    """Half vector of the common frame, scalar part.
+
+    Returns ``(hx, hy, hz, cos_d, cos_i, cos_r, sin_i)`` where ``h`` is the unit half vector
+    (``hz = cos theta_h``) and ``cos_d = w_i . h = |w_i + w_r|/2``.
+    """
+    si = math.sin(ti)
+    ci = math.cos(ti)
+    sr = math.sin(tr)
+    cr = math.cos(tr)
+    # cos(pi/2) is 6e-17, not 0; clip so that exact grazing gives exactly zero cosines.
+    if ci < 1e-15:
+        ci = 0.0
+    if cr < 1e-15:
+        cr = 0.0
+    sx = sr * math.cos(phi) - si
+    sy = sr * math.sin(phi)
+    sz = ci + cr
+    length = math.sqrt(sx * sx + sy * sy + sz * sz)
+    if length == 0.0:
+        # w_i = -w_r: both grazing and opposite (retro at theta = 90 deg). No facet can connect
+        # them; return a horizontal "half vector" with cos_d = 0 so every model gives 0 there.
+        return 1.0, 0.0, 0.0, 0.0, ci, cr, si
+    return sx / length, sy / length, sz / length, 0.5 * length, ci, cr, si
+
+
+@jit
+def ts67_projected(ti, tr, phi):
+    """TS67 projected angles ``(psi_p, theta_p, alpha_signed)`` (MODELS.md §2.4, vector form).
+
+    The projection plane is spanned by ``z`` and the horizontal direction ``u`` of the facet tilt;
+    ``psi_p >= 0`` and ``theta_p = psi_p + 2 alpha_signed`` with the paper's sign convention
+    (positive on the far side of the normal from the source). Used instead of the printed Eq. 14,
+    whose arcsin branches are wrong for 19 % of geometries.
+    """
+    hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
+    sr = math.sin(tr)
+    wrx = sr * math.cos(phi)
+    wry = sr * math.sin(phi)
+    hxy = math.sqrt(hx * hx + hy * hy)
+    if hxy > 1e-300:
+        ux = hx / hxy
+        uy = hy / hxy
+    else:
+        # alpha = 0 (specular): any horizontal u works; take the plane of incidence.
+        ux = 1.0
+        uy = 0.0
+    alpha = math.acos(min(1.0, hz))
+    a_i = math.atan2(-si * ux, ci)
+    a_r = math.atan2(wrx * ux + wry * uy, cr)
+    if a_i <= 0.0:
+        return -a_i, a_r, alpha
+    return a_i, -a_r, -alpha
+
+
+@jit
+def tr75_eta_from_h(si, ci, hx, hy, hz):
+    """TR75 angle eta between the local and the macroscopic planes of incidence (Eq. 23).
+
+    ``sin eta sin s = h_y`` and ``cos eta sin s = (w_i x h)_y = sin(theta_i) h_z + cos(theta_i) h_x``
+    (MODELS.md §3.5, recommended sign). At ``s = 0`` both vanish and eta = 0 (R_s = R_p there).
+    """
+    return math.atan2(hy, si * hz + ci * hx)
+
+
+# --------------------------------------------------------------------------------------------
+# NumPy front ends of the scalar parts
+# --------------------------------------------------------------------------------------------
+@ufunc(3)
+def _theta_h(ti, tr, phi):
+    hz = half_vector(ti, tr, phi)[2]
+    return math.acos(max(-1.0, min(1.0, hz)))
+
+
+@ufunc(3)
+def _theta_d(ti, tr, phi):
+    cd = half_vector(ti, tr, phi)[3]
+    return math.acos(max(-1.0, min(1.0, cd)))
+
+
+@ufunc(3)
+def _phi_h(ti, tr, phi):
+    sr = math.sin(tr)
+    return math.atan2(sr * math.sin(phi), sr * math.cos(phi) - math.sin(ti))
+
+
+@ufunc(3)
+def _psi_p(ti, tr, phi):
+    return ts67_projected(ti, tr, phi)[0]
+
+
+@ufunc(3)
+def _theta_p(ti, tr, phi):
+    return ts67_projected(ti, tr, phi)[1]
+
+
+@ufunc(3)
+def _eta(ti, tr, phi):
+    hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
+    return tr75_eta_from_h(si, ci, hx, hy, hz)
+
+
+def theta_h(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> np.ndarray:
+    """Zenith angle of the half vector (facet normal), radians; TS67 alpha, TR75 alpha."""
+    return _theta_h(*check_angles(theta_i, theta_r, phi))
+
+
+def theta_d(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> np.ndarray:
+    """Local angle of incidence on the facet, radians; TS67 psi', TR75 s."""
+    return _theta_d(*check_angles(theta_i, theta_r, phi))
+
+
+def phi_h(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> np.ndarray:
+    """Azimuth of the half vector in the common frame (MODELS.md §1.1), radians."""
+    return _phi_h(*check_angles(theta_i, theta_r, phi))
+
+
+def ts67_psi_p(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> np.ndarray:
+    """TS67 projected incidence angle psi_p >= 0 (MODELS.md §2.4)."""
+    return _psi_p(*check_angles(theta_i, theta_r, phi))
+
+
+def ts67_theta_p(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> np.ndarray:
+    """TS67 projected reflection angle theta_p (signed, MODELS.md §2.4)."""
+    return _theta_p(*check_angles(theta_i, theta_r, phi))
+
+
+def tr75_eta(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> np.ndarray:
+    """TR75 eta: angle from the macroscopic to the local plane of incidence (Eq. 23), radians."""
+    return _eta(*check_angles(theta_i, theta_r, phi))
+
+
+# --------------------------------------------------------------------------------------------
+# vectors and conversions (NumPy; not used inside kernels)
+# --------------------------------------------------------------------------------------------
+def unit_vectors(
+    theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike
+) -> tuple[np.ndarray, np.ndarray]:
+    """Unit vectors ``(w_i, w_r)`` of the common frame, each of shape ``(..., 3)``."""
+    ti, tr, ph = (np.asarray(v, dtype=float) for v in (theta_i, theta_r, phi))
+    ti, tr, ph = np.broadcast_arrays(ti, tr, ph)
+    wi = np.stack([-np.sin(ti), np.zeros_like(ti), np.cos(ti)], axis=-1)
+    wr = np.stack([np.sin(tr) * np.cos(ph), np.sin(tr) * np.sin(ph), np.cos(tr)], axis=-1)
+    return wi, wr
+
+
+def angles_from_vectors(w_i: ArrayLike, w_r: ArrayLike) -> tuple[np.ndarray, ...]:
+    """Common-frame angles from arbitrary unit vectors ``(..., 3)`` (isotropic surfaces).
+
+    The pair is rotated about ``z`` so that ``w_i`` lies in the x-z plane on the ``-x`` side.
+    """
+    wi = np.asarray(w_i, dtype=float)
+    wr = np.asarray(w_r, dtype=float)
+    ti = np.arccos(np.clip(wi[..., 2], -1.0, 1.0))
+    tr = np.arccos(np.clip(wr[..., 2], -1.0, 1.0))
+    phi_i = np.arctan2(wi[..., 1], wi[..., 0])
+    phi_r = np.arctan2(wr[..., 1], wr[..., 0])
+    phi = np.mod(phi_r - phi_i + np.pi, 2 * np.pi)  # source at azimuth pi -> forward at 0
+    phi = np.where(phi > np.pi, phi - 2 * np.pi, phi)
+    return ti, tr, phi
+
+
+def _wrap(phi: np.ndarray) -> np.ndarray:
+    """Wrap an azimuth to (-pi, pi]."""
+    out = np.mod(phi + np.pi, 2 * np.pi) - np.pi
+    return np.where(out == -np.pi, np.pi, out)
+
+
+def from_ts67(psi: ArrayLike, theta: ArrayLike, phi: ArrayLike) -> tuple[np.ndarray, ...]:
+    """TS67 ``(psi, theta, phi)`` -> common frame; TS67's frame is the common frame (§1.3)."""
+    return tuple(np.asarray(v, dtype=float) for v in (psi, theta, phi))
+
+
+def to_ts67(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> tuple[np.ndarray, ...]:
+    """Common frame -> TS67 ``(psi, theta, phi)`` (identical conventions, MODELS.md §1.3)."""
+    return tuple(np.asarray(v, dtype=float) for v in (theta_i, theta_r, phi))
+
+
+def from_tr75(beta: ArrayLike, elevation: ArrayLike, psi: ArrayLike) -> tuple[np.ndarray, ...]:
+    """TR75 ``(beta, elevation theta, azimuth psi from the source side)`` -> common frame.
+
+    ``theta_r = pi/2 - elevation``, ``phi = pi - psi`` (MODELS.md §1.3; TR75 report Eqs. 9, 11).
+    """
+    b = np.asarray(beta, dtype=float)
+    return b, HALF_PI - np.asarray(elevation, dtype=float), _wrap(np.pi - np.asarray(psi, float))
+
+
+def to_tr75(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> tuple[np.ndarray, ...]:
+    """Common frame -> TR75 ``(beta, elevation, psi)``; ``psi`` in [0, 2 pi)."""
+    psi = np.mod(np.pi - np.asarray(phi, dtype=float), 2 * np.pi)
+    return np.asarray(theta_i, float), HALF_PI - np.asarray(theta_r, float), psi
+
+
+def to_rb08(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> tuple[np.ndarray, ...]:
+    """Common frame -> RB08 direction cosines ``(alpha, beta, alpha0)`` (MODELS.md §4.3).
+
+    ``alpha = sin theta_s cos phi``, ``beta = sin theta_s sin phi``, ``alpha0 = sin theta_i``;
+    the specular point is ``(alpha0, 0)`` and the retro point ``(-alpha0, 0)``.
+    """
+    tr = np.asarray(theta_r, dtype=float)
+    ph = np.asarray(phi, dtype=float)
+    return np.sin(tr) * np.cos(ph), np.sin(tr) * np.sin(ph), np.sin(np.asarray(theta_i, float))
+
+
+def from_rb08(alpha: ArrayLike, beta: ArrayLike, alpha0: ArrayLike) -> tuple[np.ndarray, ...]:
+    """RB08 direction cosines -> common frame; requires ``alpha^2 + beta^2 <= 1``."""
+    a = np.asarray(alpha, dtype=float)
+    b = np.asarray(beta, dtype=float)
+    r = np.hypot(a, b)
+    if np.any(r > 1.0 + 1e-12):
+        raise ValueError(f"direction cosines outside the unit disk: |(alpha, beta)| = {r.max()!r}")
+    a0 = np.asarray(alpha0, dtype=float)
+    if np.any((a0 < 0) | (a0 > 1)):
+        raise ValueError(f"alpha0 = sin(theta_i) must be in [0, 1], got {a0!r}")
+    return np.arcsin(a0), np.arcsin(np.minimum(r, 1.0)), np.arctan2(b, a)
+
+
+def _rot_z(v: np.ndarray, ang: np.ndarray) -> np.ndarray:
+    c, s = np.cos(ang), np.sin(ang)
+    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1], v[..., 2]], -1)
+
+
+def _rot_y(v: np.ndarray, ang: np.ndarray) -> np.ndarray:
+    c, s = np.cos(ang), np.sin(ang)
+    return np.stack([c * v[..., 0] + s * v[..., 2], v[..., 1], -s * v[..., 0] + c * v[..., 2]], -1)
+
+
+def to_rusinkiewicz(
+    theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike
+) -> tuple[np.ndarray, ...]:
+    """Common frame -> Rusinkiewicz (1998) half/difference angles ``(theta_h, theta_d, phi_d)``.
+
+    ``d`` is ``w_i`` expressed in the frame where ``h`` is the pole: rotate by ``-phi_h`` about
+    z, then by ``-theta_h`` about y; ``phi_d = atan2(d_y, d_x)`` in (-pi, pi].
+    """
+    wi, wr = unit_vectors(theta_i, theta_r, phi)
+    s = wi + wr
+    norm = np.linalg.norm(s, axis=-1, keepdims=True)
+    h = s / np.where(norm == 0, 1.0, norm)
+    th = np.arccos(np.clip(h[..., 2], -1, 1))
+    ph = np.arctan2(h[..., 1], h[..., 0])
+    d = _rot_y(_rot_z(wi, -ph), -th)
+    td = np.arccos(np.clip(d[..., 2], -1, 1))
+    pd = np.arctan2(d[..., 1], d[..., 0])
+    return th, td, pd
+
+
+def from_rusinkiewicz(
+    theta_h: ArrayLike, theta_d: ArrayLike, phi_d: ArrayLike
+) -> tuple[np.ndarray, ...]:
+    """Rusinkiewicz ``(theta_h, theta_d, phi_d)`` -> common frame ``(theta_i, theta_r, phi)``.
+
+    Directions whose ``w_i`` or ``w_r`` falls below the horizon give NaN (they are not BRDF
+    geometries); isotropy fixes ``phi_h`` so that the source lies at azimuth pi.
+    """
+    th, td, pd = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (theta_h, theta_d,
+                                                                          phi_d)))
+    d = np.stack([np.sin(td) * np.cos(pd), np.sin(td) * np.sin(pd), np.cos(td)], -1)
+    dr = d * np.array([-1.0, -1.0, 1.0])  # w_r is w_i mirrored about h
+    wi = _rot_y(d, th)
+    wr = _rot_y(dr, th)
+    ti, tr, phi = angles_from_vectors(wi, wr)
+    below = (wi[..., 2] < -1e-12) | (wr[..., 2] < -1e-12)
+    return (np.where(below, np.nan, ti), np.where(below, np.nan, tr),
+            np.where(below, np.nan, phi))
+
+
+def signed_angle(theta_r: ArrayLike, phi: ArrayLike) -> np.ndarray:
+    """In-plane signed reflection angle: ``+theta_r`` at phi = 0, ``-theta_r`` at phi = pi."""
+    tr = np.asarray(theta_r, dtype=float)
+    return np.where(np.cos(np.asarray(phi, dtype=float)) < 0, -tr, tr)
+
+
+def from_signed_angle(theta_signed: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """Signed in-plane angle -> ``(theta_r, phi)`` with phi in {0, pi}."""
+    t = np.asarray(theta_signed, dtype=float)
+    return np.abs(t), np.where(t < 0, np.pi, 0.0)

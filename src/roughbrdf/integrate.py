@@ -1,0 +1,91 @@
+"""Directional-hemispherical reflectance (albedo) and reciprocity checks.
+
+``albedo(model, theta_i) = ∫_hemisphere f_r(theta_i, w_r) cos(theta_r) dω_r``.
+
+Why a hand-written quadrature: the integrand can be a lobe a few degrees wide (TR75 with
+e = 0.05) sitting anywhere on the hemisphere and cut by the horizon, which generic cubature
+(``scipy.integrate.nquad``) handles slowly and unreliably. Here the hemisphere is parametrized
+by polar coordinates ``(rho, psi)`` *centred on the specular direction* ``w_s``::
+
+    w_r = cos(rho) w_s + sin(rho) (cos(psi) e1 + sin(psi) e2),   dω = sin(rho) drho dpsi
+
+Each ray ``psi`` is integrated exactly up to the horizon ``rho_max(psi)`` (where ``w_r,z = 0``), so
+the horizon cut is not a discontinuity of the integrand; ``rho`` uses composite Gauss-Legendre
+panels graded geometrically from ``1e-4`` rad (resolving lobes of any width centred at the
+specular direction); ``psi`` uses the periodic trapezoid rule (spectrally accurate). All samples
+of all incidences are evaluated in one vectorized model call.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .geometry import check_zenith
+from .models.base import Model, polarization_array
+
+__all__ = ["albedo", "reciprocity_error"]
+
+
+def _rho_panels(n_panels: int, order: int) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes/weights on [0, 1] in units of rho_max, graded geometrically toward 0."""
+    x, w = np.polynomial.legendre.leggauss(order)
+    edges = np.concatenate([[0.0], np.geomspace(1e-4 / math.pi, 1.0, n_panels)])
+    nodes, weights = [], []
+    for a, b in zip(edges[:-1], edges[1:], strict=True):
+        nodes.append(0.5 * (b - a) * x + 0.5 * (a + b))
+        weights.append(0.5 * (b - a) * w)
+    return np.concatenate(nodes), np.concatenate(weights)
+
+
+def albedo(model: Model, theta_i: ArrayLike, *, polarization=None, n_psi: int = 256,
+           n_panels: int = 24, order: int = 12) -> np.ndarray | float:
+    """Directional-hemispherical reflectance of ``model`` at incidence ``theta_i`` (radians).
+
+    Accurate to about 1e-5 absolute for the facet models, including sharp lobes (e = 0.05);
+    ``n_psi``, ``n_panels`` and ``order`` trade accuracy for time.
+
+    Examples
+    --------
+    >>> import roughbrdf as rb
+    >>> round(float(rb.albedo(rb.model("lambertian", rho=0.5), 0.3)), 8)
+    0.5
+    """
+    ti = check_zenith(theta_i, "theta_i", open_upper=not model.grazing_incidence)
+    gamma = polarization_array(polarization)
+    if gamma.ndim:
+        raise ValueError("albedo takes one polarization for all incidences")
+    shape = ti.shape
+    t = ti.reshape(-1, 1, 1)
+    u, wu = _rho_panels(n_panels, order)  # fraction of rho_max
+    psi = (np.arange(n_psi) + 0.5) * (2 * math.pi / n_psi)
+    cp, sp = np.cos(psi)[None, :, None], np.sin(psi)[None, :, None]
+    # specular direction w_s and the orthonormal pair (e1, e2) perpendicular to it
+    sz, sx = np.cos(t), np.sin(t)
+    # tangent direction t(psi) = cos psi e1 + sin psi e2, e1 = (cos ti, 0, -sin ti), e2 = y
+    tx, ty, tz = cp * sz, sp, -cp * sx
+    # horizon: w_z = cos(rho) sz + sin(rho) tz = 0  ->  rho_max = atan2(sz, -tz) in (0, pi]
+    rho_max = np.arctan2(sz, -tz)
+    rho = u[None, None, :] * rho_max
+    cr_, sr_ = np.cos(rho), np.sin(rho)
+    wx = cr_ * sx + sr_ * tx
+    wy = sr_ * ty
+    wz = np.clip(cr_ * sz + sr_ * tz, 0.0, 1.0)
+    theta_r = np.arccos(wz)
+    phi = np.arctan2(wy, wx)
+    f = model._evaluate(np.broadcast_to(t, theta_r.shape), theta_r, phi, gamma, 1)  # f cos(theta_r)
+    integrand = f * sr_ * rho_max * wu[None, None, :]
+    out = integrand.sum(axis=(1, 2)) * (2 * math.pi / n_psi)
+    out = out.reshape(shape)
+    return float(out) if out.ndim == 0 else out
+
+
+def reciprocity_error(model: Model, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike
+                      ) -> np.ndarray:
+    """Relative difference ``|f(i, r) - f(r, i)| / max(f)`` (0 for a reciprocal model)."""
+    a = np.asarray(model.brdf(theta_i, theta_r, phi))
+    b = np.asarray(model.brdf(theta_r, theta_i, phi))
+    scale = np.maximum(np.maximum(np.abs(a), np.abs(b)), 1e-300)
+    return np.abs(a - b) / scale

@@ -1,0 +1,21 @@
+"""Models: one module per published model, plus Lambertian, generic microfacet and sums."""
+
+from .base import MODELS, Model, Parameter, SumModel, available, model, register
+from .lambertian import Lambertian
+from .microfacet import Microfacet
+from .torrance_sparrow import TorranceSparrow1967
+from .trowbridge_reitz import TrowbridgeReitz1975
+
+__all__ = [
+    "MODELS",
+    "Model",
+    "Parameter",
+    "SumModel",
+    "available",
+    "model",
+    "register",
+    "Lambertian",
+    "Microfacet",
+    "TorranceSparrow1967",
+    "TrowbridgeReitz1975",
+]

@@ -1,0 +1,99 @@
+"""Generic microfacet BRDF ``F D G / (4 cos theta_i cos theta_r)`` from named parts.
+
+Cook & Torrance (1982) / Walter et al. (2007) form, built from :mod:`roughbrdf.distributions`,
+:mod:`roughbrdf.shadowing` and :mod:`roughbrdf.fresnel`::
+
+    f_r = ks F(theta_d) D(theta_h) G / (4 cos theta_i cos theta_r)
+
+``F`` at the local angle ``theta_d`` (polarization per TR75 Eq. 24); ``n=None`` gives ``F = 1``.
+``ks`` is an overall scale (1 for a physical surface; free for fits to data of unknown scale).
+The parameter ``alpha`` is the width parameter of the chosen distribution: ``e`` for
+Trowbridge-Reitz/GGX and Berry, ``m`` for Beckmann, ``c`` (per degree) for gaussian-angle, ``A2``
+for Sirohi.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .. import distributions as dist
+from .. import shadowing as shd
+from .._jit import jit
+from ..fresnel import check_index, fresnel_polarized
+from ..geometry import half_vector, tr75_eta_from_h
+from .base import Model, Parameter, nonnegative, positive, register
+
+
+@jit
+def _micro_point(ti, tr, phi, gamma, p, flag):
+    alpha, n, k, ks, dcode, scode, norm, use_f = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
+    dcode = int(dcode)
+    scode = int(scode)
+    hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
+    if use_f > 0.0:
+        eta = 0.0 if gamma != gamma else tr75_eta_from_h(si, ci, hx, hy, hz)
+        f = fresnel_polarized(cd, n, k, gamma, eta)
+    else:
+        f = 1.0
+    d = dist.evaluate_d(dcode, hz, alpha, norm)
+    if flag:  # BRIDF = f_r cos(theta_r): the 1/cos(theta_r) is never formed
+        if scode == shd.NONE:
+            geo = 1.0 / ci
+        elif scode == shd.V_GROOVE:
+            geo = shd.v_groove_g(ci, cr, hz, cd) / ci
+        else:
+            geo = shd.smith_g_over_cos_cos(scode, dcode, alpha, ci, cr) * cr
+    else:
+        geo = shd.g_over_cos_cos(scode, dcode, alpha, ci, cr, hz, cd)
+    return 0.25 * ks * f * d * geo
+
+
+@register
+class Microfacet(Model):
+    """Microfacet BRDF with distribution, shadowing and Fresnel chosen by name.
+
+    Examples
+    --------
+    >>> import roughbrdf as rb
+    >>> m = rb.model("microfacet", distribution="ggx", alpha=0.3, shadowing="smith", n=1.5, k=0.0)
+    >>> m.options["distribution"], m.options["shadowing"]
+    ('trowbridge-reitz', 'smith-height-correlated')
+    """
+
+    name = "microfacet"
+    aliases = ("cook-torrance",)
+    short = "microfacet"
+    reference = "Cook & Torrance 1982; Walter et al. 2007"
+    PARAMETERS = (
+        positive("alpha", 0.3, (0.01, 2.0), "1", "width parameter of the distribution"),
+        Parameter("n", 1.5, (0.2, 5.0), "1", "refractive index (None: F = 1)",
+                  (0.0, False, math.inf, False), optional=True),
+        Parameter("k", 0.0, (0.0, 10.0), "1", "extinction index (n + ik)",
+                  (0.0, True, math.inf, False), optional=True),
+        nonnegative("ks", 1.0, (0.0, 20.0), "1", "scale of the specular term"),
+    )
+    OPTIONS = {"distribution": "trowbridge-reitz", "shadowing": "smith-height-correlated"}
+    _point = _micro_point
+
+    def _check_options(self, options):
+        d = dist.get(options["distribution"])
+        s = shd.get(options["shadowing"])
+        if s in (shd.SMITH_SEPARABLE, shd.SMITH_HEIGHT_CORRELATED) and not d.smith:
+            raise ValueError(f"shadowing {options['shadowing']!r} needs a distribution with a "
+                             f"Smith Lambda (trowbridge-reitz, beckmann), got {d.name!r}")
+        return {"distribution": d.name, "shadowing": shd.canonical(s)}
+
+    def _validate(self) -> None:
+        d = dist.get(self._options["distribution"])
+        dist.check_param(d.code, self._values["alpha"], "alpha")
+        n, k = self._values["n"], self._values["k"]
+        if n is not None:
+            check_index(n, 0.0 if k is None else k)
+
+    def _pack(self) -> tuple:
+        v = self._values
+        d = dist.get(self._options["distribution"])
+        use_f = v["n"] is not None
+        return (v["alpha"], v["n"] if use_f else 1.0, (v["k"] or 0.0) if use_f else 0.0,
+                v["ks"], d.code, shd.get(self._options["shadowing"]),
+                dist.normalization(d.code, v["alpha"]), 1.0 if use_f else 0.0)

@@ -1,0 +1,120 @@
+"""Torrance & Sparrow (1967): V-groove facets, gaussian slope-angle distribution, Fresnel.
+
+K. E. Torrance and E. M. Sparrow, "Theory for off-specular reflection from roughened surfaces",
+J. Opt. Soc. Am. 57(9), 1105-1114 (1967). MODELS.md §2.
+
+Absolute form (from Eq. 12, MODELS.md §2.3)::
+
+    f_r = (rho_d/pi) [ g F(theta_d) G exp(-c^2 alpha^2) / (cos theta_i cos theta_r) + 1 ]
+
+with ``alpha = theta_h`` in degrees and ``c`` per degree (MODELS.md §2.3), ``G`` the V-groove
+attenuation factor (Table I = the 3-D closed form), ``F`` the Fresnel reflectance at the local
+angle ``theta_d`` (unpolarized unless a polarization is given; ``n=None`` gives ``F = 1``), and
+``g = b f dω_i/(4 a)`` the paper's ratio of facet to diffuse contributions. The first term is the
+facet part (``P(alpha) = b exp(-c^2 alpha^2)`` with ``b f/4`` absorbed into ``g rho_d/pi``), the
+second the uniform diffuse part ``a/dω_i = rho_d/pi``. Dividing by its value at the specular
+direction gives the paper's relative reflectance, Eq. 23 (:meth:`TorranceSparrow1967.relative`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .. import distributions as dist
+from .._jit import jit
+from ..fresnel import check_index, fresnel_polarized
+from ..geometry import half_vector, tr75_eta_from_h
+from ..shadowing import v_groove_g, v_groove_g_over_cos_r
+from .base import Model, Parameter, nonnegative, positive, register
+
+
+@jit
+def _ts67_point(ti, tr, phi, gamma, p, flag):
+    g, c, n, k, rho_d, use_f = p[0], p[1], p[2], p[3], p[4], p[5]
+    hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
+    if use_f > 0.0:
+        eta = 0.0 if gamma != gamma else tr75_eta_from_h(si, ci, hx, hy, hz)
+        f = fresnel_polarized(cd, n, k, gamma, eta)
+    else:
+        f = 1.0
+    gauss = dist.peak(dist.GAUSS_ANGLE, hz, c)  # exp(-(c alpha_deg)^2), TS67 Eq. 5
+    if flag:  # BRIDF: f_r cos(theta_r) -> G itself, no 1/cos(theta_r)
+        return rho_d / math.pi * (g * f * v_groove_g(ci, cr, hz, cd) * gauss / ci + cr)
+    return rho_d / math.pi * (g * f * v_groove_g_over_cos_r(ci, cr, hz, cd) * gauss / ci + 1.0)
+
+
+@register
+class TorranceSparrow1967(Model):
+    """Torrance-Sparrow (1967) off-specular reflection model (MODELS.md §2).
+
+    Parameters
+    ----------
+    g : float
+        Ratio of facet to diffuse contributions (TS67 Eq. 13); 0 = purely diffuse.
+    c : float
+        Width of the gaussian facet-angle distribution, **per degree** (0.05 in the paper).
+    n, k : float or None
+        Complex index ``n + i k`` of the facet material; ``n=None`` sets ``F = 1`` (Figs. 8, 10, 11).
+    rho_d : float
+        Scale of the absolute form: ``rho_d/pi`` is the diffuse BRDF (sr⁻¹).
+
+    Notes
+    -----
+    Angles are the common frame (TS67's own psi, theta, phi are the same). ``theta_i`` must be
+    below 90 deg (Eq. 23's denominator ``g F/cos psi`` diverges). The model is finite at
+    ``theta_r = 90 deg`` through the per-branch ``G/cos theta_r`` (MODELS.md §2.5).
+
+    Examples
+    --------
+    >>> import numpy as np, roughbrdf as rb
+    >>> ts = rb.model("torrance-sparrow-1967", g=2/3, c=0.05, n=None, k=None, rho_d=0.3)
+    >>> round(float(ts.relative(np.radians(75), np.radians(80), 0.0)), 3)   # MODELS.md §2.7
+    1.425
+    """
+
+    name = "torrance-sparrow-1967"
+    aliases = ("ts67", "torrance-sparrow")
+    short = "ts67"
+    reference = "Torrance & Sparrow, JOSA 57, 1105 (1967)"
+    PARAMETERS = (
+        nonnegative("g", 2.0 / 3.0, (0.0, 50.0), "1",
+                    "ratio of facet to diffuse contributions (Eq. 13)"),
+        positive("c", 0.05, (0.005, 0.5), "1/deg",
+                 "gaussian facet-angle width, exp(-(c alpha_deg)^2) (Eq. 5)"),
+        Parameter("n", None, (0.2, 5.0), "1", "refractive index (None: F = 1)",
+                  (0.0, False, math.inf, False), optional=True),
+        Parameter("k", None, (0.0, 10.0), "1", "extinction index, n + ik (None: 0)",
+                  (0.0, True, math.inf, False), optional=True),
+        positive("rho_d", 0.3, (1e-4, 1.0), "1", "diffuse reflectance scale, rho_d/pi sr^-1"),
+    )
+
+    def _validate(self) -> None:
+        n, k = self._values["n"], self._values["k"]
+        if n is None and k not in (None, 0.0):
+            raise ValueError(f"parameter 'k' = {k!r} given without 'n' (n=None means F = 1)")
+        if n is not None:
+            check_index(n, 0.0 if k is None else k)
+
+    def _pack(self) -> tuple:
+        v = self._values
+        use_f = v["n"] is not None
+        return (v["g"], v["c"], v["n"] if use_f else 1.0, (v["k"] or 0.0) if use_f else 0.0,
+                v["rho_d"], 1.0 if use_f else 0.0)
+
+    _point = _ts67_point
+
+    def relative(self, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
+                 polarization=None) -> np.ndarray | float:
+        """TS67 Eq. 23: ``rho(psi; theta, phi)/rho(psi; psi, 0)``, relative to the specular value.
+
+        Equal to ``brdf(theta_i, theta_r, phi)/brdf(theta_i, theta_i, 0)``: at the specular
+        direction ``G = 1``, ``alpha = 0`` and ``theta_d = psi``, so the ratio of the absolute
+        forms is exactly Eq. 23 (``rho_d`` cancels).
+        """
+        ti, tr, ph, gam = self._prepare(theta_i, theta_r, phi, polarization)
+        num = self._evaluate(ti, tr, ph, gam, 0)
+        den = self._evaluate(ti, ti, np.zeros_like(ti), gam, 0)
+        return num / den

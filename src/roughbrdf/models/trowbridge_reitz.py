@@ -1,0 +1,102 @@
+"""Trowbridge & Reitz (1975): ellipsoid "average irregularity", absolute BRIDF, polarization.
+
+T. S. Trowbridge and K. P. Reitz, "Average irregularity representation of a rough surface for
+ray reflection", J. Opt. Soc. Am. 65(5), 531-536 (1975); Naval Missile Center report TP-75-01.
+MODELS.md §3.
+
+BRIDF (Eqs. 30, 32, 33), in sr⁻¹::
+
+    f_rI = R(s, gamma, n, k) e^2 / [4 pi cos(beta) (e^2 cos^2 alpha + sin^2 alpha)^2]
+           + sin(theta_elev) rho_L / pi
+
+with ``beta = theta_i``, ``alpha = theta_h``, ``s = theta_d``, ``sin(theta_elev) = cos theta_r``.
+The specular part equals ``R D/(4 cos theta_i)`` with ``D`` the normalized Trowbridge-Reitz (GGX,
+alpha = e) distribution. ``brdf = bridf/cos theta_r``. ``R`` follows Eq. 24 with the angle ``eta``
+between the local and macroscopic planes of incidence (MODELS.md §3.5).
+
+The published model has no shadowing, so its BRDF diverges at ``theta_r = 90 deg``: there
+``brdf()`` returns its limit ``inf`` while ``bridf()`` stays finite. The report's footnote allows
+multiplying by TS67's G (option ``shadowing="v-groove"``), which makes the BRDF finite.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .. import distributions as dist
+from .. import shadowing as shd
+from .._jit import jit
+from ..fresnel import check_index, fresnel_polarized
+from ..geometry import half_vector, tr75_eta_from_h
+from .base import Model, nonnegative, positive, register, unit_interval
+
+
+@jit
+def _tr75_point(ti, tr, phi, gamma, p, flag):
+    e, n, k, rho_l, shadow = p[0], p[1], p[2], p[3], p[4]
+    hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
+    eta = 0.0 if gamma != gamma else tr75_eta_from_h(si, ci, hx, hy, hz)
+    r = fresnel_polarized(cd, n, k, gamma, eta)
+    spec = r * dist.evaluate_d(dist.TR, hz, e, 1.0 / (math.pi * e * e)) / (4.0 * ci)
+    if flag:  # BRIDF, Eq. 33
+        if shadow > 0.0:
+            spec *= shd.v_groove_g(ci, cr, hz, cd)
+        return spec + cr * rho_l / math.pi
+    # BRDF = BRIDF / cos(theta_r)
+    if shadow > 0.0:
+        return spec * shd.v_groove_g_over_cos_r(ci, cr, hz, cd) + rho_l / math.pi
+    if cr <= 0.0:
+        return math.inf  # unshadowed Eq. 30 over cos(theta_r) diverges at the horizon
+    return spec / cr + rho_l / math.pi
+
+
+@register
+class TrowbridgeReitz1975(Model):
+    """Trowbridge-Reitz (1975) ellipsoid model plus a Lambertian part (MODELS.md §3).
+
+    Parameters
+    ----------
+    e : float
+        Ellipsoid axis ratio (rotation axis / perpendicular axis); < 1 glossy, > 1 prolate.
+    n, k : float
+        Complex index ``n + i k`` (TR75 writes ``n - i k``; same reflectance).
+    rho_L : float
+        Directional-hemispherical reflectance of the Lambertian part (Eq. 32).
+    shadowing : {"none", "v-groove"}
+        Option: multiply the specular part by TS67's G (report footnote). Default ``"none"``.
+
+    Examples
+    --------
+    >>> import roughbrdf as rb
+    >>> m = rb.model("trowbridge-reitz-1975", e=0.68, n=1.0, k=0.9, rho_L=0.33)
+    >>> round(m.bridf(0.0, 0.0, 0.0), 5)      # R(0)/(4 pi e^2) + rho_L/pi
+    0.13402
+    """
+
+    name = "trowbridge-reitz-1975"
+    aliases = ("tr75", "trowbridge-reitz")
+    short = "tr75"
+    reference = "Trowbridge & Reitz, JOSA 65, 531 (1975)"
+    PARAMETERS = (
+        positive("e", 0.68, (0.02, 3.0), "1", "ellipsoid axis ratio (GGX alpha = e)"),
+        positive("n", 1.0, (0.2, 5.0), "1", "refractive index (n + ik)"),
+        nonnegative("k", 0.9, (0.0, 10.0), "1", "extinction index (n + ik), >= 0 absorbing"),
+        unit_interval("rho_L", 0.33, "Lambertian directional-hemispherical reflectance"),
+    )
+    OPTIONS = {"shadowing": "none"}
+    _point = _tr75_point
+
+    def _check_options(self, options):
+        code = shd.get(options["shadowing"])
+        if code not in (shd.NONE, shd.V_GROOVE):
+            raise ValueError(f"TR75 shadowing must be 'none' or 'v-groove' (report footnote), "
+                             f"got {options['shadowing']!r}")
+        return {"shadowing": shd.canonical(code)}
+
+    def _validate(self) -> None:
+        check_index(self._values["n"], self._values["k"])
+
+    def _pack(self) -> tuple:
+        v = self._values
+        return (v["e"], v["n"], v["k"], v["rho_L"],
+                1.0 if self._options["shadowing"] == "v-groove" else 0.0)

@@ -1,0 +1,466 @@
+"""Matplotlib figures for models and measurements.
+
+Every ``plot_*`` function takes ``ax=`` (an existing :class:`matplotlib.axes.Axes`; a new figure is
+made when it is ``None``) and returns ``(fig, ax)``. New figures are built with
+:class:`matplotlib.figure.Figure` directly, never through ``pyplot``, so no global figure state
+is created or leaked and any backend (Agg included) works; save them with ``fig.savefig(path)``.
+
+Angles are radians in every argument (the library's convention) and degrees on the plot axes.
+The in-plane axis is the papers' *signed* reflection angle: ``+theta_r`` on the forward
+(specular) side ``phi = 0``, ``-theta_r`` on the source side ``phi = pi``
+(:func:`roughbrdf.geometry.signed_angle`).
+
+=========================  ==================================================================
+function                   what it draws
+=========================  ==================================================================
+:func:`plot_in_plane`      model in the plane of incidence, several incidences (TS67 Fig. 8)
+:func:`plot_polar`         TR75-style polar plot of the BRIDF against azimuth, ⊥ and ∥ (Fig. 6)
+:func:`plot_hemisphere`    heat map on the projected disk ``(sin θ cos φ, sin θ sin φ)``
+:func:`plot_comparison`    measurement vs model, in-plane slices, one colour per incidence
+:func:`plot_residual_map`  relative residual ``(data - model)/model`` on the projected disk
+=========================  ==================================================================
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from matplotlib import colors as mcolors
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from numpy.typing import ArrayLike
+
+from . import geometry
+from .measurement import Measurement
+from .models.base import Model
+
+__all__ = [
+    "new_axes",
+    "incidence_colors",
+    "model_values",
+    "best_scale",
+    "plot_in_plane",
+    "plot_polar",
+    "plot_hemisphere",
+    "plot_comparison",
+    "plot_residual_map",
+]
+
+QUANTITY_LABELS = {
+    "brdf": r"BRDF $f_r$ [sr$^{-1}$]",
+    "bridf": r"BRIDF $f_r\cos\theta_r$ [sr$^{-1}$]",
+    "brdf_cos": r"$f_r\cos\theta_r$ [sr$^{-1}$]",
+    "relative": r"relative reflectance $f_r/f_r(\mathrm{specular})$",
+}
+SIGNED_LABEL = r"signed reflection angle $\theta_r$ [deg] (negative = source side)"
+
+
+# --------------------------------------------------------------------------------------------
+# helpers
+# --------------------------------------------------------------------------------------------
+def new_axes(ax: Axes | None = None, *, polar: bool = False,
+             figsize: tuple[float, float] = (6.4, 4.8)) -> tuple[Figure, Axes]:
+    """Return ``(fig, ax)``: ``ax``'s figure, or a new pyplot-free figure with one axes."""
+    if ax is not None:
+        return ax.get_figure(), ax
+    fig = Figure(figsize=figsize, layout="constrained")
+    ax = fig.add_subplot(projection="polar" if polar else None)
+    return fig, ax
+
+
+def incidence_colors(n: int, cmap: str = "viridis") -> list[Any]:
+    """``n`` distinguishable colours (one per incidence), dark to light."""
+    from matplotlib import colormaps
+
+    cm = colormaps[cmap]
+    if n <= 1:
+        return [cm(0.15)]
+    return [cm(x) for x in np.linspace(0.05, 0.85, n)]
+
+
+def _as_list(theta: ArrayLike) -> list[float]:
+    return [float(t) for t in np.atleast_1d(np.asarray(theta, dtype=float))]
+
+
+def model_values(model: Model, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
+                 quantity: str = "brdf", polarization: Any = None) -> np.ndarray:
+    """The model's ``brdf``, ``bridf``/``brdf_cos`` or ``relative`` value (specular = 1).
+
+    ``relative`` uses the model's own ``relative`` method when it has one (TS67 Eq. 23) and
+    ``brdf / brdf(specular)`` otherwise.
+    """
+    if quantity == "brdf":
+        out = model.brdf(theta_i, theta_r, phi, polarization)
+    elif quantity in ("bridf", "brdf_cos"):
+        out = model.bridf(theta_i, theta_r, phi, polarization)
+    elif quantity == "relative":
+        if hasattr(model, "relative"):
+            out = model.relative(theta_i, theta_r, phi, polarization)
+        else:
+            num = np.asarray(model.brdf(theta_i, theta_r, phi, polarization), dtype=float)
+            den = np.asarray(model.brdf(theta_i, theta_i, 0.0, polarization), dtype=float)
+            out = num / den
+    else:
+        raise ValueError(f"quantity must be 'brdf', 'bridf', 'brdf_cos' or 'relative', "
+                         f"got {quantity!r}")
+    return np.asarray(out, dtype=float)
+
+
+def best_scale(data: ArrayLike, model: ArrayLike) -> float:
+    """Closed-form scale ``K`` minimizing ``sum(((data - K model)/(K model))^2)``.
+
+    With ``r = data/model`` the objective is ``sum((r/K - 1)^2)``, minimized by
+    ``K = sum(r^2)/sum(r)`` (TR75 Eq. 34 with the scale put on the model). Only finite, positive
+    pairs are used; returns 1.0 if there are none.
+    """
+    d = np.asarray(data, dtype=float)
+    m = np.asarray(model, dtype=float)
+    ok = np.isfinite(d) & np.isfinite(m) & (m > 0)
+    if not ok.any():
+        return 1.0
+    r = d[ok] / m[ok]
+    s = r.sum()
+    return float((r * r).sum() / s) if s > 0 else 1.0
+
+
+def _deg(x: ArrayLike) -> np.ndarray:
+    return np.degrees(np.asarray(x, dtype=float))
+
+
+def _auto_log(values: np.ndarray) -> bool:
+    v = values[np.isfinite(values) & (values > 0)]
+    return v.size > 1 and v.max() / v.min() > 30.0
+
+
+def _signed_grid(n: int, limit_deg: float = 89.5) -> np.ndarray:
+    return np.radians(np.linspace(-limit_deg, limit_deg, n))
+
+
+# --------------------------------------------------------------------------------------------
+# model plots
+# --------------------------------------------------------------------------------------------
+def plot_in_plane(model: Model, theta_i: ArrayLike, *, quantity: str = "brdf",
+                  log: bool = False, polarization: Any = None, n: int = 721,
+                  limit_deg: float = 89.9, label: str | None = None, ax: Axes | None = None,
+                  **line_kw: Any) -> tuple[Figure, Axes]:
+    """Model in the plane of incidence on the signed reflection-angle axis (degrees).
+
+    Parameters
+    ----------
+    model : Model
+    theta_i : float or sequence of float
+        Incidence angle(s), radians; one curve (colour) per incidence.
+    quantity : {"brdf", "bridf", "relative"}
+        ``relative`` is the model divided by its specular value (TS67 Eq. 23 for TS67).
+    log : bool
+        Logarithmic value axis.
+    polarization : optional
+        Passed to the model (``None``, ``"s"``, ``"p"`` or an angle gamma in radians).
+    n, limit_deg : int, float
+        Samples and the extent of the signed axis, ``[-limit_deg, limit_deg]``.
+    label : str, optional
+        Legend label prefix (default: the model name).
+    ax : matplotlib.axes.Axes, optional
+
+    Returns
+    -------
+    (fig, ax)
+    """
+    fig, ax = new_axes(ax)
+    incs = _as_list(theta_i)
+    ts = _signed_grid(n, limit_deg)
+    tr, ph = geometry.from_signed_angle(ts)
+    prefix = f"{label}, " if label else ""
+    for t, col in zip(incs, incidence_colors(len(incs)), strict=True):
+        y = model_values(model, t, tr, ph, quantity, polarization)
+        ax.plot(_deg(ts), y, color=col, label=prefix + rf"$\theta_i$ = {math.degrees(t):g}°",
+                **line_kw)
+        ax.axvline(math.degrees(t), color=col, lw=0.6, ls=":", alpha=0.6)
+    ax.set_xlabel(SIGNED_LABEL)
+    ax.set_ylabel(QUANTITY_LABELS.get(quantity, quantity))
+    ax.set_xlim(-90, 90)
+    ax.set_xticks(np.arange(-90, 91, 30))
+    if log:
+        ax.set_yscale("log")
+    ax.set_title(label or model.name)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    return fig, ax
+
+
+def polar_curves(model: Model, theta_i: float, elevation: float, psi: ArrayLike,
+                 polarizations: Sequence[Any] = ("s", "p")) -> dict[Any, np.ndarray]:
+    """BRIDF against TR75's azimuth ``psi`` (0 toward the source) at fixed incidence/elevation.
+
+    Angles are radians in TR75's convention, converted with :func:`geometry.from_tr75`.
+    Returns ``{polarization: values}``.
+    """
+    ti, tr, ph = geometry.from_tr75(theta_i, elevation, psi)
+    return {p: np.asarray(model.bridf(ti, tr, ph, p), dtype=float) for p in polarizations}
+
+
+def plot_polar(model: Model, theta_i: float, elevation: float, *, n: int = 361,
+               polarizations: Sequence[Any] = ("s", "p"), rmax: float | None = None,
+               label: str | None = None, ax: Axes | None = None) -> tuple[Figure, Axes]:
+    """TR75-style polar plot (Fig. 6): radius = BRIDF, polar angle = azimuth ψ.
+
+    TR75 measures ψ from the source side (ψ = 0 toward the source, ψ = 180° the forward/specular
+    side); the conversion goes through :func:`roughbrdf.geometry.from_tr75`. Incident
+    polarization ⊥ (``"s"``, solid) and ∥ (``"p"``, dashed) to the plane of incidence.
+
+    Parameters
+    ----------
+    model : Model
+    theta_i, elevation : float
+        TR75 ``beta`` (incidence zenith) and ``theta`` (reflection **elevation**), radians.
+    n : int
+        Azimuth samples over the full circle.
+    polarizations : sequence
+        Polarizations to draw (default ⊥ and ∥); ``None`` adds the unpolarized mean.
+    """
+    fig, ax = new_axes(ax, polar=True)
+    psi = np.linspace(0.0, 2 * math.pi, n)
+    curves = polar_curves(model, theta_i, elevation, psi, polarizations)
+    styles = {"s": ("-", "⊥ (s)"), "p": ("--", "∥ (p)"), None: (":", "unpolarized")}
+    for p, y in curves.items():
+        ls, name = styles.get(p, ("-.", f"γ = {p}"))
+        ax.plot(psi, y, ls=ls, color="k" if p in ("s", None) else "C3", label=name)
+    ax.set_theta_zero_location("N")  # psi = 0 (toward the source) at the top
+    ax.set_theta_direction(-1)
+    if rmax is not None:
+        ax.set_rlim(0, rmax)
+    ax.set_xlabel(r"azimuth $\psi$ (0° toward the source) [deg]", labelpad=4)
+    ax.set_ylabel(r"BRIDF [sr$^{-1}$]", labelpad=28)
+    head = f"{label}: " if label else ""
+    ax.set_title(rf"{head}$\beta$ = {math.degrees(theta_i):g}°, "
+                 rf"$\theta$ = {math.degrees(elevation):g}° elev.", fontsize="medium")
+    ax.legend(loc="lower left", bbox_to_anchor=(-0.12, -0.12), fontsize="small")
+    return fig, ax
+
+
+def hemisphere_grid(n: int = 201) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Projected-disk grid: ``(x, y, theta_r, phi)`` with NaN angles outside the unit disk."""
+    x = np.linspace(-1.0, 1.0, n)
+    X, Y = np.meshgrid(x, x)
+    r = np.hypot(X, Y)
+    inside = r <= 1.0
+    tr = np.where(inside, np.arcsin(np.minimum(r, 1.0)), np.nan)
+    ph = np.where(inside, np.arctan2(Y, X), np.nan)
+    return X, Y, tr, ph
+
+
+def plot_hemisphere(model: Model, theta_i: float, *, quantity: str = "brdf", log: bool = True,
+                    polarization: Any = None, n: int = 201, cmap: str = "magma",
+                    vmin: float | None = None, vmax: float | None = None,
+                    ax: Axes | None = None) -> tuple[Figure, Axes]:
+    """Heat map of the model over the reflection hemisphere, on the projected disk.
+
+    ``x = sin θ_r cos φ`` (forward/specular side to the right), ``y = sin θ_r sin φ``; the source
+    sits at ``(-sin θ_i, 0)`` and the specular direction at ``(+sin θ_i, 0)``. With ``log`` the
+    colours are logarithmic; a colorbar is added.
+    """
+    fig, ax = new_axes(ax, figsize=(5.6, 4.8))
+    X, Y, tr, ph = hemisphere_grid(n)
+    inside = np.isfinite(tr)
+    Z = np.full(X.shape, np.nan)
+    Z[inside] = model_values(model, theta_i, tr[inside], ph[inside], quantity, polarization)
+    Z[~np.isfinite(Z)] = np.nan
+    pos = Z[np.isfinite(Z) & (Z > 0)]
+    norm: mcolors.Normalize
+    if log and pos.size:
+        lo = vmin if vmin is not None else max(pos.min(), pos.max() * 1e-4)
+        norm = mcolors.LogNorm(vmin=lo, vmax=vmax if vmax is not None else pos.max())
+        Z = np.where(Z > 0, Z, np.nan)
+    else:
+        norm = mcolors.Normalize(vmin=vmin, vmax=vmax)
+    mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(Z), shading="auto", cmap=cmap, norm=norm,
+                         rasterized=True)
+    fig.colorbar(mesh, ax=ax, label=QUANTITY_LABELS.get(quantity, quantity), shrink=0.9)
+    _disk_decorations(ax)
+    s = math.sin(theta_i)
+    ax.plot([s], [0], marker="+", ms=10, color="c", ls="none", label="specular")
+    ax.plot([-s], [0], marker="x", ms=7, color="c", ls="none", label="source (retro)")
+    ax.legend(loc="upper right", fontsize="x-small", framealpha=0.6)
+    ax.set_title(rf"{model.name}, $\theta_i$ = {math.degrees(theta_i):g}°", fontsize="medium")
+    return fig, ax
+
+
+def _disk_decorations(ax: Axes) -> None:
+    t = np.linspace(0, 2 * math.pi, 361)
+    for deg in (30, 60, 90):
+        r = math.sin(math.radians(deg))
+        ax.plot(r * np.cos(t), r * np.sin(t), color="0.6", lw=0.6 if deg < 90 else 1.0)
+    ax.axhline(0, color="0.6", lw=0.5)
+    ax.set_aspect("equal")
+    ax.set_xlim(-1.05, 1.05)
+    ax.set_ylim(-1.05, 1.05)
+    ax.set_xlabel(r"$x = \sin\theta_r\cos\phi$ (forward $\rightarrow$)")
+    ax.set_ylabel(r"$y = \sin\theta_r\sin\phi$")
+
+
+# --------------------------------------------------------------------------------------------
+# measurement vs model
+# --------------------------------------------------------------------------------------------
+def _comparison_setup(model: Model, measurement: Measurement, channel: int | str
+                      ) -> tuple[Measurement, np.ndarray, np.ndarray, str, float]:
+    """Single channel; model values at the samples, matched to the data's quantity.
+
+    Returns ``(meas, data, model_at_samples, quantity_used, scale)``: ``brdf`` is compared with
+    the model BRDF, ``brdf_cos``/``bridf`` with BRDF·cosθr, ``relative`` with the model BRDF
+    scaled by the closed-form best ``K`` (:func:`best_scale`).
+    """
+    meas = measurement.select_channel(channel)
+    data = meas.values[:, 0]
+    q = meas.quantity
+    pol = meas.polarization
+    if q in ("brdf_cos", "bridf"):
+        mod = model_values(model, meas.theta_i, meas.theta_r, meas.phi, "bridf", pol)
+    else:
+        mod = model_values(model, meas.theta_i, meas.theta_r, meas.phi, "brdf", pol)
+    scale = best_scale(data, mod) if q == "relative" else 1.0
+    return meas, data, mod * scale, q, scale
+
+
+def _pol_groups(meas: Measurement) -> list[tuple[Any, np.ndarray, str]]:
+    """Split samples by incident polarization: ``[(pol, mask, label)]``."""
+    if meas.polarization is None or np.all(np.isnan(meas.polarization)):
+        return [(None, np.ones(meas.n_samples, bool), "")]
+    out = []
+    g = np.round(meas.polarization, 9)
+    if np.isnan(g).any():
+        out.append((None, np.isnan(g), " unpol."))
+    for val in np.unique(g[~np.isnan(g)]):
+        mask = g == val
+        name = {0.0: " ∥", round(math.pi / 2, 9): " ⊥"}.get(float(val),
+                                                              f" γ={math.degrees(val):g}°")
+        out.append((float(val), mask, name))
+    return out
+
+
+def _pol_mask(meas: Measurement, pol: float | None) -> np.ndarray:
+    if meas.polarization is None:
+        return np.full(meas.n_samples, pol is None)
+    g = np.round(meas.polarization, 9)
+    return np.isnan(g) if pol is None else g == pol
+
+
+def plot_comparison(model: Model, measurement: Measurement, *, channel: int | str = 0,
+                    ax: Axes | None = None) -> tuple[Figure, Axes]:
+    """Measurement vs model: in-plane slices on the signed angle axis, one colour per incidence.
+
+    Markers are the measured in-plane samples (``phi`` within 0.5° of 0 or 180°), lines the model
+    at the same incidence (and polarization, if the data have one). The compared quantity follows
+    ``measurement.quantity``: ``brdf`` against the model BRDF; ``brdf_cos``/``bridf`` against
+    BRDF·cosθr; ``relative`` against the model BRDF times the closed-form best scale ``K``
+    (:func:`best_scale`, given in the title). The value axis is logarithmic when the data span
+    more than a factor 30. A measurement with no in-plane samples is shown as a parity plot
+    (model against data) instead.
+    """
+    fig, ax = new_axes(ax)
+    meas, data, mod, q, scale = _comparison_setup(model, measurement, channel)
+    ylabel = QUANTITY_LABELS["bridf" if q in ("bridf", "brdf_cos") else "brdf"]
+    if q == "relative":
+        ylabel = r"relative value (model BRDF $\times K$)"
+    inplane = meas.in_plane()
+    title = f"{model.name} vs {meas.meta.get('sample') or meas.meta.get('file') or 'data'}"
+    title += f" [{meas.channels[0]}]"
+    if q == "relative":
+        title += f", K = {scale:.4g}"
+    if inplane.n_samples == 0:
+        ok = np.isfinite(data) & np.isfinite(mod) & (data > 0) & (mod > 0)
+        ax.loglog(data[ok], mod[ok], ".", ms=3, alpha=0.6, label="samples")
+        if ok.any():
+            lo, hi = min(data[ok].min(), mod[ok].min()), max(data[ok].max(), mod[ok].max())
+            ax.plot([lo, hi], [lo, hi], "k-", lw=0.8, label="model = data")
+        ax.set_xlabel("measured " + ylabel)
+        ax.set_ylabel("model " + ylabel)
+        ax.set_title(title + " (no in-plane samples: parity plot)", fontsize="medium")
+        ax.legend(fontsize="small")
+        return fig, ax
+    incs = inplane.incidences(4)
+    cols = incidence_colors(len(incs))
+    ts_grid = _signed_grid(361, 89.5)
+    tr_g, ph_g = geometry.from_signed_angle(ts_grid)
+    curve_q = "bridf" if q in ("bridf", "brdf_cos") else "brdf"
+    groups = _pol_groups(inplane)
+    markers = ["o", "s", "^", "D"]
+    all_vals = []
+    for t, col in zip(incs, cols, strict=True):
+        sel = inplane.at_incidence(float(t), atol=1e-4)
+        for gi, (pol, _mask, pname) in enumerate(groups):
+            sub = sel.subset(_pol_mask(sel, pol)) if len(groups) > 1 else sel
+            if sub.n_samples == 0:
+                continue
+            x = _deg(geometry.signed_angle(sub.theta_r, sub.phi))
+            y = sub.values[:, 0]
+            all_vals.append(y)
+            ax.plot(x, y, ls="none", marker=markers[gi % 4], ms=3.5, mfc="none", color=col,
+                    label=rf"data $\theta_i$ = {math.degrees(t):.3g}°{pname}")
+            yc = scale * model_values(model, float(t), tr_g, ph_g, curve_q, pol)
+            ax.plot(_deg(ts_grid), yc, color=col, lw=1.2, ls="-" if gi == 0 else "--",
+                    label=rf"model $\theta_i$ = {math.degrees(t):.3g}°{pname}")
+    vals = np.concatenate(all_vals) if all_vals else np.array([])
+    if _auto_log(vals):
+        ax.set_yscale("log")
+        pos = vals[np.isfinite(vals) & (vals > 0)]
+        ax.set_ylim(pos.min() / 3, pos.max() * 3)
+    ax.set_xlim(-90, 90)
+    ax.set_xticks(np.arange(-90, 91, 30))
+    ax.set_xlabel(SIGNED_LABEL)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize="medium")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="x-small", ncol=2 if len(incs) * len(groups) > 4 else 1)
+    return fig, ax
+
+
+def relative_residuals(model: Model, measurement: Measurement, *, channel: int | str = 0
+                       ) -> tuple[Measurement, np.ndarray]:
+    """``(meas, (data - model)/model)`` for one channel, with the quantity handling of
+    :func:`plot_comparison` (NaN where the model is not positive and finite)."""
+    meas, data, mod, _q, _s = _comparison_setup(model, measurement, channel)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        res = np.where(np.isfinite(mod) & (mod > 0), (data - mod) / mod, np.nan)
+    return meas, res
+
+
+def plot_residual_map(model: Model, measurement: Measurement, *, channel: int | str = 0,
+                      ax: Axes | None = None) -> tuple[Figure, Axes]:
+    """Relative residual ``(data - model)/model`` of every sample on the projected disk.
+
+    Each sample sits at ``(sin θr cos φ, sin θr sin φ)`` (forward side to the right), coloured
+    by its residual on a diverging scale symmetric about 0 (clipped at the 98th percentile of
+    ``|residual|``); each incidence has its own marker. The r.m.s. relative residual (TR75's
+    σ, Eq. 34) is in the title.
+    """
+    fig, ax = new_axes(ax, figsize=(6.0, 4.8))
+    meas, res = relative_residuals(model, measurement, channel=channel)
+    x = np.sin(meas.theta_r) * np.cos(meas.phi)
+    y = np.sin(meas.theta_r) * np.sin(meas.phi)
+    ok = np.isfinite(res)
+    lim = float(np.percentile(np.abs(res[ok]), 98)) if ok.any() else 1.0
+    lim = lim if lim > 0 else 1.0
+    norm = mcolors.TwoSlopeNorm(vcenter=0.0, vmin=-lim, vmax=lim)
+    markers = ["o", "s", "^", "D", "v", "P", "X", "*", "<", ">"]
+    incs = meas.incidences(4)
+    sc = None
+    for j, t in enumerate(incs):
+        m = (np.abs(meas.theta_i - t) <= 1e-4) & ok
+        if not m.any():
+            continue
+        sc = ax.scatter(x[m], y[m], c=np.clip(res[m], -lim, lim), cmap="RdBu_r", norm=norm,
+                        marker=markers[j % len(markers)], s=14, edgecolors="0.3",
+                        linewidths=0.2, label=rf"$\theta_i$ = {math.degrees(t):.3g}°")
+        ax.plot([math.sin(t)], [0.0], marker="+", color="k", ms=6, ls="none")
+    if sc is not None:
+        fig.colorbar(sc, ax=ax, label="(data − model) / model", shrink=0.9)
+    _disk_decorations(ax)
+    rms = float(np.sqrt(np.mean(res[ok] ** 2))) if ok.any() else float("nan")
+    ax.set_title(f"{model.name}: relative residual [{meas.channels[0]}], r.m.s. {rms:.3g}",
+                 fontsize="medium")
+    if len(incs) <= 12:
+        ax.legend(fontsize="x-small", loc="upper left", framealpha=0.6)
+    return fig, ax

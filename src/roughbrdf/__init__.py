@@ -10,6 +10,7 @@ See ``roughbrdf.geometry`` for the conversions to each paper's own angles.
 
 from . import distributions, fresnel, geometry, shadowing
 from .integrate import albedo, reciprocity_error
+from .io import read, write
 from .models import Model, Parameter, SumModel, available, model
 
 __version__ = "0.1.0"
@@ -23,7 +24,9 @@ __all__ = [
     "model",
     "Model",
     "Parameter",
+    "read",
     "reciprocity_error",
     "shadowing",
     "SumModel",
+    "write",
 ]

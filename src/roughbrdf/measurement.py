@@ -3,7 +3,7 @@
 Data flows one way: file -> reader (:mod:`roughbrdf.io`) -> :class:`Measurement` -> ``fit`` ->
 ``FitResult``. A measurement never silently drops samples: non-finite and negative values are
 counted by :meth:`Measurement.validate` and reported; a fit chooses what to do with them by an
-explicit option.
+explicit option and :meth:`Measurement.drop`, which returns what it removed.
 """
 
 from __future__ import annotations
@@ -24,15 +24,18 @@ __all__ = ["Measurement", "QUANTITIES"]
 #: quantity proportional to f_r with an unknown scale (TR75's relative BRIDF is relative x cos).
 QUANTITIES = ("brdf", "brdf_cos", "bridf", "relative")
 
+#: provenance keys that every reader fills in ``meta`` (None when the file does not say)
+PROVENANCE = ("file", "format", "sample", "instrument", "date")
 
-@dataclass
+
+@dataclass(eq=False, repr=False)
 class Measurement:
     """A set of BRDF samples.
 
     Attributes
     ----------
     theta_i, theta_r, phi : numpy.ndarray, shape (N,)
-        Geometry in the common frame (radians; phi = 0 forward/specular side).
+        Geometry in the common frame (radians; phi = 0 forward/specular side, pi source side).
     values : numpy.ndarray, shape (N, C)
         One column per channel.
     channels : list of str
@@ -44,9 +47,11 @@ class Measurement:
     uncertainty : numpy.ndarray, shape (N, C), optional
         One-sigma uncertainty of ``values`` (same unit).
     original : dict of str -> numpy.ndarray
-        The file's own angle columns, untouched (e.g. ``{"theta_l": ..., "x1": ...}``).
+        The file's own angle columns, untouched (e.g. ``{"theta_l": ..., "x1": ...}``), each of
+        shape (N,), in the file's own units (``meta["original_units"]`` says which).
     meta : dict
-        Provenance: ``file``, ``format``, ``sample``, ``instrument``, ``date`` and anything else.
+        Provenance: ``file``, ``format``, ``sample``, ``instrument``, ``date`` and anything else
+        the reader found (the raw header is under ``meta["header"]``).
     """
 
     theta_i: np.ndarray
@@ -81,9 +86,14 @@ class Measurement:
         if len(self.channels) != v.shape[1]:
             raise ValueError(f"{len(self.channels)} channel labels for {v.shape[1]} value "
                              f"columns{where}")
+        if len(set(self.channels)) != len(self.channels):
+            raise ValueError(f"channel labels must be distinct, got {self.channels}{where}")
         if self.quantity not in QUANTITIES:
             raise ValueError(f"quantity must be one of {QUANTITIES}, got {self.quantity!r}{where}")
-        check_angles(self.theta_i, self.theta_r, self.phi)
+        try:
+            check_angles(self.theta_i, self.theta_r, self.phi)
+        except ValueError as exc:
+            raise ValueError(f"{exc}{where}") from exc
         if self.polarization is not None:
             self.polarization = np.broadcast_to(
                 np.asarray(self.polarization, dtype=float), (n,)).copy()
@@ -91,17 +101,62 @@ class Measurement:
             u = np.asarray(self.uncertainty, dtype=float)
             self.uncertainty = np.broadcast_to(u if u.ndim == 2 else u.reshape(-1, 1),
                                                v.shape).copy()
+        orig = {}
+        for k, a in (self.original or {}).items():
+            a = np.asarray(a)
+            if a.shape[:1] != (n,):
+                raise ValueError(f"original[{k!r}] has shape {a.shape}, expected ({n}, ...)"
+                                 f"{where}")
+            orig[str(k)] = a
+        self.original = orig
+        self.meta = dict(self.meta or {})
 
+    def __repr__(self) -> str:
+        return (f"<Measurement {self.n_samples} samples x {len(self.channels)} channels "
+                f"{self.channels}, {self.quantity}, file={self.meta.get('file')!r}>")
+
+    # ------------------------------------------------------------------------------------------
+    # size and provenance
     # ------------------------------------------------------------------------------------------
     @property
     def n_samples(self) -> int:
         return int(self.theta_i.size)
 
+    @property
+    def n_channels(self) -> int:
+        return int(self.values.shape[1])
+
     def __len__(self) -> int:
         return self.n_samples
 
+    @property
+    def file(self) -> str | None:
+        """Path of the file read (``meta["file"]``)."""
+        return self.meta.get("file")
+
+    @property
+    def sample(self) -> str | None:
+        """Sample name declared in the file (``meta["sample"]``)."""
+        return self.meta.get("sample")
+
+    @property
+    def instrument(self) -> str | None:
+        """Instrument / laboratory (``meta["instrument"]``)."""
+        return self.meta.get("instrument")
+
+    @property
+    def date(self) -> str | None:
+        """Measurement date as written in the file (``meta["date"]``)."""
+        return self.meta.get("date")
+
+    # ------------------------------------------------------------------------------------------
+    # validation
+    # ------------------------------------------------------------------------------------------
     def validate(self) -> dict[str, dict[str, int]]:
-        """Count non-finite and negative values per channel (nothing is removed)."""
+        """Count non-finite and negative values per channel (nothing is removed).
+
+        Returns ``{channel: {"n": N, "nonfinite": count, "negative": count}}``.
+        """
         report = {}
         for j, ch in enumerate(self.channels):
             col = self.values[:, j]
@@ -109,11 +164,75 @@ class Measurement:
                           "negative": int((col < 0).sum())}
         return report
 
+    def validation_text(self) -> str:
+        """One line per channel with the counts of :meth:`validate` (for reports and the CLI)."""
+        lines = []
+        for ch, r in self.validate().items():
+            lines.append(f"channel {ch}: {r['n']} values, {r['nonfinite']} non-finite, "
+                         f"{r['negative']} negative")
+        return "\n".join(lines)
+
+    def bad_mask(self, *, nonfinite: bool = True, negative: bool = False,
+                 channels: list[int | str] | None = None) -> np.ndarray:
+        """Boolean (N,) mask of the samples :meth:`drop` would remove with the same options."""
+        idx = (range(self.n_channels) if channels is None
+               else [self.channel_index(c) for c in channels])
+        v = self.values[:, list(idx)]
+        bad = np.zeros(self.n_samples, dtype=bool)
+        if nonfinite:
+            bad |= (~np.isfinite(v)).any(axis=1)
+        if negative:
+            bad |= (v < 0).any(axis=1)
+        return bad
+
+    def drop(self, *, nonfinite: bool = True, negative: bool = False,
+             channels: list[int | str] | None = None) -> tuple[Measurement, dict[str, Any]]:
+        """Remove the samples with non-finite and/or negative values, and say what was removed.
+
+        A sample (row) is removed when any of the considered ``channels`` (default: all) has a
+        non-finite value (``nonfinite=True``) or a negative value (``negative=True``). For a
+        per-channel fit, call :meth:`select_channel` first so that a bad value in one channel does
+        not remove the others' good values.
+
+        Returns
+        -------
+        (Measurement, dict)
+            The kept samples, and ``{"n_before", "n_after", "n_dropped", "mask" (bool (N,) of the
+            removed rows), "nonfinite": {channel: count}, "negative": {channel: count}}`` where the
+            per-channel counts are those of the removed rows. The same record (without the mask)
+            is appended to ``meta["dropped"]`` of the returned measurement.
+        """
+        idx = (list(range(self.n_channels)) if channels is None
+               else [self.channel_index(c) for c in channels])
+        bad = self.bad_mask(nonfinite=nonfinite, negative=negative, channels=idx)
+        v = self.values
+        info: dict[str, Any] = {
+            "n_before": self.n_samples,
+            "n_after": int((~bad).sum()),
+            "n_dropped": int(bad.sum()),
+            "options": {"nonfinite": nonfinite, "negative": negative,
+                        "channels": [self.channels[j] for j in idx]},
+            "nonfinite": {self.channels[j]: int((~np.isfinite(v[bad, j])).sum()) for j in idx},
+            "negative": {self.channels[j]: int((v[bad, j] < 0).sum()) for j in idx},
+        }
+        kept = self.subset(~bad)
+        kept.meta["dropped"] = list(self.meta.get("dropped", [])) + [dict(info)]
+        info["mask"] = bad
+        return kept, info
+
+    # ------------------------------------------------------------------------------------------
+    # selection
+    # ------------------------------------------------------------------------------------------
     def channel_index(self, channel: int | str) -> int:
-        """Index of a channel given by label or position."""
+        """Index of a channel given by label or position (``"525"`` also finds ``"525nm"``)."""
         if isinstance(channel, str):
             if channel in self.channels:
                 return self.channels.index(channel)
+            alt = [i for i, c in enumerate(self.channels) if c.removesuffix("nm") == channel]
+            if len(alt) == 1:
+                return alt[0]
+            if channel.lstrip("-").isdigit() and not alt:
+                return self.channel_index(int(channel))
             raise ValueError(f"unknown channel {channel!r}; channels: {self.channels}")
         idx = int(channel)
         if not -len(self.channels) <= idx < len(self.channels):
@@ -121,7 +240,7 @@ class Measurement:
         return idx % len(self.channels)
 
     def subset(self, mask: np.ndarray) -> Measurement:
-        """A new measurement with only the samples where ``mask`` is true."""
+        """A new measurement with only the samples where ``mask`` is true (or at indices)."""
         mask = np.asarray(mask)
         return replace(
             self,
@@ -140,6 +259,13 @@ class Measurement:
                        uncertainty=None if self.uncertainty is None
                        else self.uncertainty[:, j:j + 1], meta=dict(self.meta))
 
+    def select_channels(self, channels: list[int | str]) -> Measurement:
+        """A measurement with the given channels, in the given order."""
+        idx = [self.channel_index(c) for c in channels]
+        return replace(self, values=self.values[:, idx], channels=[self.channels[j] for j in idx],
+                       uncertainty=None if self.uncertainty is None
+                       else self.uncertainty[:, idx], meta=dict(self.meta))
+
     def incidences(self, decimals: int = 6) -> np.ndarray:
         """Distinct incidence angles (radians, rounded to ``decimals``)."""
         return np.unique(np.round(self.theta_i, decimals))
@@ -154,6 +280,19 @@ class Measurement:
         on = (np.abs(np.abs(c) - 1.0) <= 1.0 - math.cos(atol)) | (self.theta_r <= atol)
         return self.subset(on)
 
+    def with_polarization(self, gamma: float | None) -> Measurement:
+        """Samples with incident polarization angle ``gamma`` (radians; None = unpolarized)."""
+        if self.polarization is None:
+            if gamma is None:
+                return self.subset(np.ones(self.n_samples, dtype=bool))
+            return self.subset(np.zeros(self.n_samples, dtype=bool))
+        if gamma is None:
+            return self.subset(np.isnan(self.polarization))
+        return self.subset(np.abs(self.polarization - gamma) <= 1e-9)
+
+    # ------------------------------------------------------------------------------------------
+    # quantities
+    # ------------------------------------------------------------------------------------------
     def to_brdf(self) -> np.ndarray:
         """Values converted to BRDF (sr⁻¹) where the quantity allows it (brdf_cos/bridf / cos)."""
         if self.quantity == "brdf":
@@ -164,9 +303,41 @@ class Measurement:
                 return self.values / c
         raise ValueError("a 'relative' measurement has no absolute BRDF scale")
 
+    def as_quantity(self, quantity: str) -> Measurement:
+        """The same samples holding ``quantity`` (``brdf`` <-> ``brdf_cos``/``bridf``).
+
+        Uncertainties are scaled with the values. ``relative`` converts to nothing else; anything
+        converts to ``relative`` only by relabelling (the values are kept).
+        """
+        if quantity not in QUANTITIES:
+            raise ValueError(f"quantity must be one of {QUANTITIES}, got {quantity!r}")
+        if quantity == self.quantity:
+            return replace(self, meta=dict(self.meta))
+        if quantity == "relative":
+            return replace(self, quantity="relative", meta=dict(self.meta))
+        if self.quantity == "relative":
+            raise ValueError("a 'relative' measurement has no absolute scale; cannot convert it "
+                             f"to {quantity!r}")
+        cos_family = ("brdf_cos", "bridf")
+        if self.quantity in cos_family and quantity in cos_family:
+            factor = np.ones((self.n_samples, 1))
+        else:
+            c = np.cos(self.theta_r)[:, None]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                factor = c if quantity in cos_family else 1.0 / c
+        return replace(self, values=self.values * factor, quantity=quantity,
+                       uncertainty=None if self.uncertainty is None
+                       else self.uncertainty * np.abs(factor), meta=dict(self.meta))
+
+    # ------------------------------------------------------------------------------------------
     def summary(self) -> str:
-        """One paragraph describing the measurement."""
+        """One paragraph describing the measurement, with its validation counts."""
         inc = ", ".join(f"{math.degrees(t):g}" for t in self.incidences(4))
-        return (f"{self.meta.get('file', '<memory>')}: {self.n_samples} samples x "
+        text = (f"{self.meta.get('file', '<memory>')}: {self.n_samples} samples x "
                 f"{len(self.channels)} channels {self.channels}, quantity {self.quantity}, "
                 f"incidences [{inc}] deg; sample {self.meta.get('sample', '?')!r}")
+        bad = {ch: r for ch, r in self.validate().items() if r["nonfinite"] or r["negative"]}
+        if bad:
+            text += "; " + ", ".join(f"{ch}: {r['nonfinite']} non-finite, {r['negative']} "
+                                     "negative" for ch, r in bad.items())
+        return text

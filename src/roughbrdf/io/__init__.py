@@ -1,0 +1,130 @@
+"""Readers and writers of measured-BRDF files; one module per format.
+
+========  ====================  ==============================================  ======  ======
+format    extensions            module                                          read    write
+========  ====================  ==============================================  ======  ======
+astm      ``.astm``             :mod:`roughbrdf.io.astm` (ASTM E1392 text)      yes     yes
+alta      ``.dat``, ``.alta``   :mod:`roughbrdf.io.alta` (ALTA text)            yes     yes
+merl      ``.binary``, ``.merl``  :mod:`roughbrdf.io.merl` (MERL 2003 binary)   yes     yes
+csv       ``.csv``              :mod:`roughbrdf.io.csv` (roughbrdf CSV)         yes     yes
+========  ====================  ==============================================  ======  ======
+
+``read(path)`` chooses the format from the extension (``format=`` overrides); when the
+extension is unknown it looks at the first bytes. Every problem with a file raises
+:class:`FormatError` (a ``ValueError``) whose message starts with the path and, where one line is
+at fault, the line number (also in ``.path`` and ``.line``).
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import re
+from pathlib import Path
+from typing import Any
+
+from ..measurement import Measurement
+from ._common import FormatError
+
+__all__ = ["read", "write", "FormatError", "FORMATS", "format_for"]
+
+#: format name -> module name under roughbrdf.io
+FORMATS = {"astm": "astm", "alta": "alta", "merl": "merl", "csv": "csv"}
+_ALIASES = {"ascii": "alta", "dat": "alta", "binary": "merl", "e1392": "astm", "txt": "alta"}
+
+
+def _module(fmt: str):
+    try:
+        return importlib.import_module(f"{__name__}.{FORMATS[fmt]}")
+    except ModuleNotFoundError as exc:
+        if exc.name != f"{__name__}.{FORMATS[fmt]}":
+            raise
+        raise FormatError(f"format {fmt!r} is not available in this version") from None
+
+
+def _extensions(fmt: str) -> tuple[str, ...]:
+    try:
+        return tuple(getattr(_module(fmt), "EXTENSIONS", ()))
+    except FormatError:
+        return ()
+
+
+def _normalize(fmt: str, path=None) -> str:
+    key = fmt.strip().lower().lstrip(".")
+    key = _ALIASES.get(key, key)
+    if key not in FORMATS:
+        raise FormatError(f"unknown format {fmt!r}; known formats: {', '.join(FORMATS)}", path)
+    return key
+
+
+def _sniff(path: Path) -> str | None:
+    """Guess a format from the first bytes (None when nothing matches)."""
+    try:
+        size = path.stat().st_size
+        with open(path, "rb") as fh:
+            head = fh.read(4096)
+    except OSError:
+        return None
+    if size >= 12:
+        import numpy as np
+
+        dims = np.frombuffer(head[:12], dtype="<i4")
+        if dims.tolist() == [90, 90, 180]:
+            return "merl"
+    text = head.decode("utf-8", errors="replace")
+    if text.lstrip().startswith("# roughbrdf-csv"):
+        return "csv"
+    if re.search(r"^#DIM\s+\d+\s+\d+", text, re.MULTILINE):
+        return "alta"
+    if re.search(r"^VARS\s", text, re.MULTILINE) and re.search(r"^NUM_POINTS\s", text,
+                                                                 re.MULTILINE):
+        return "astm"
+    return None
+
+
+def format_for(path: str | os.PathLike, format: str | None = None) -> str:
+    """The format name used for ``path``: ``format`` if given, else from the extension,
+    else from the contents (for an existing file); raises :class:`FormatError` otherwise."""
+    if format:
+        return _normalize(format, path)
+    p = Path(path)
+    ext = p.suffix.lower()
+    for name in FORMATS:
+        if ext in _extensions(name):
+            return name
+    if p.is_file():
+        guess = _sniff(p)
+        if guess:
+            return guess
+    known = ", ".join(f"{e} ({n})" for n in FORMATS for e in _extensions(n))
+    raise FormatError(f"unknown format for extension {ext or '(none)'!r}; known extensions: "
+                      f"{known}; pass format= (CLI: --from/--to)", path)
+
+
+def read(path: str | os.PathLike, format: str | None = None, **options: Any) -> Measurement:
+    """Read a measurement file into a :class:`~roughbrdf.measurement.Measurement`.
+
+    Parameters
+    ----------
+    path : str or path-like
+    format : {"astm", "alta", "merl", "csv"}, optional
+        Override the format chosen from the extension.
+    **options
+        Passed to the format's reader, e.g. ``quantity="brdf_cos"`` (ALTA without
+        ``#PARAM_OUT``), ``angles="deg"`` (ASTM), ``stride=4`` (MERL).
+    """
+    p = Path(path)
+    if not p.exists():
+        raise FileNotFoundError(f"{p}: no such file")
+    fmt = format_for(p, format)
+    return _module(fmt).read(p, **options)
+
+
+def write(measurement: Measurement, path: str | os.PathLike, format: str | None = None,
+          **options: Any) -> None:
+    """Write a measurement in the format chosen from the extension (``format=`` overrides)."""
+    fmt = format_for(path, format)
+    mod = _module(fmt)
+    if not hasattr(mod, "write"):
+        raise FormatError(f"format {fmt!r} has no writer", path)
+    mod.write(measurement, path, **options)

@@ -36,6 +36,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import distributions as _dist
+from . import special as _special
 from ._jit import as_float_array, jit, ufunc
 from .geometry import check_angles, half_vector, ts67_projected
 
@@ -53,6 +54,11 @@ __all__ = [
     "smith",
     "g_over_cos_r",
     "g_over_cos_cos",
+    "V",
+    "Vm",
+    "rb08_v",
+    "rb08_vm",
+    "rb08_e0",
 ]
 
 NONE, V_GROOVE, SMITH_SEPARABLE, SMITH_HEIGHT_CORRELATED = 0, 1, 2, 3
@@ -265,3 +271,116 @@ def smith(theta_i: ArrayLike, theta_r: ArrayLike, alpha: float,
     _dist.check_param(d.code, float(alpha), "alpha")
     ti, tr, _ = check_angles(theta_i, theta_r, 0.0)
     return _smith_g(code, d.code, float(alpha), np.cos(ti), np.cos(tr))
+
+
+# --------------------------------------------------------------------------------------------
+# RB08: Renhorn & Boreman (2008) shadowing V (Eqs. 10-12) and masking multiplier Vm (Eqs. 13-15)
+# --------------------------------------------------------------------------------------------
+# MODELS.md §4.7-4.8. The scalar parts are used inside the RB08 model kernel
+# (roughbrdf.models.renhorn_boreman); V and Vm below are their NumPy front ends.
+
+
+@jit
+def rb08_v(chi, scale, a, st):
+    """Scalar RB08 shadowing ``V = Q(a, scale chi^2)`` (Eq. 10), fast arguments.
+
+    ``a = 1 + n``, ``scale = (1 + n)/w^2`` and ``st = stirlerr(a)`` are precomputed once per
+    parameter set; ``Q`` is :func:`roughbrdf.special.gammaincc_q` (exp for n = 0, a finite sum
+    for integer n, series/continued fraction otherwise).
+    """
+    return _special.gammaincc_q(a, scale * chi * chi, st)
+
+
+@jit
+def rb08_e0(zeta0, gamma, delta):
+    """Scalar ``E0 = exp(-gamma zeta0 exp(-delta zeta0^2))``, the incidence weight of Eq. 13."""
+    return math.exp(-gamma * zeta0 * math.exp(-delta * zeta0 * zeta0))
+
+
+@jit
+def rb08_vm(zeta, e0, alpha2, w_a, w_b):
+    """Scalar RB08 masking/shadowing multiplier Vm (Eq. 13) given ``E0`` (:func:`rb08_e0`).
+
+    ``B = exp(-w_a zeta exp(-w_b alpha^2))``; Eq. 13 with ``Sgn`` is, piecewise,
+    ``zeta < 0: B``; ``zeta > 0: 1 - E0 (1 - B)``; ``zeta = 0 (Sgn 0 = 0): (1 - E0 + B + B E0)/2``
+    (= 1, since B = 1 there: Vm is continuous).
+    """
+    if w_a == 0.0:
+        return 1.0  # B = 1 exactly, and every branch of Eq. 13 is then 1
+    u = -w_a * zeta * math.exp(-w_b * alpha2)  # log B
+    if zeta < 0.0:
+        return math.exp(u)
+    if zeta > 0.0:
+        return 1.0 + e0 * math.expm1(u)  # 1 - E0 (1 - B) without cancellation when B ~ 1
+    b = math.exp(u)
+    return 0.5 * (1.0 - e0 + b + b * e0)  # the literal Sgn(0) = 0 value of Eq. 13
+
+
+@ufunc(3)
+def _rb08_v_ufunc(chi, w, n):
+    a = 1.0 + n
+    return rb08_v(chi, a / (w * w), a, _special.stirlerr(a))
+
+
+@ufunc(7)
+def _rb08_vm_ufunc(zeta, zeta0, alpha, w_a, w_b, gamma, delta):
+    return rb08_vm(zeta, rb08_e0(zeta0, gamma, delta), alpha * alpha, w_a, w_b)
+
+
+def _finite(x: ArrayLike, name: str) -> np.ndarray:
+    arr = as_float_array(x, name)
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        raise ValueError(f"{name} must be finite, got {arr[bad].flat[0]!r}")
+    return arr
+
+
+def V(chi: ArrayLike, w: ArrayLike, n: ArrayLike) -> np.ndarray:
+    """RB08 shadowing function ``V(chi, w, n) = Γ(1+n, (1+n) chi²/w²)/Γ(1+n)`` (Eq. 10).
+
+    The regularized upper incomplete gamma ``Q(1+n, (1+n) chi²/w²)`` for real ``n >= 0``
+    (``n!`` of the paper read as ``Γ(1+n)``). ``chi`` is a sine of a zenith angle (RB08 uses
+    ``sin theta_i`` and ``sin theta_s``), ``w > 0`` the cut-off and ``n`` the sharpness:
+    ``V(0) = 1``, ``V(chi, w, 0) = exp(-chi²/w²)`` (Eq. 11), ``V(w) -> 1/2`` and
+    ``V -> [chi < w]`` as ``n -> inf``. Arrays broadcast.
+
+    Examples
+    --------
+    >>> import roughbrdf as rb
+    >>> round(float(rb.shadowing.V(0.5, 0.8, 0.0)), 12)      # exp(-0.25/0.64), Eq. 11
+    0.676633846161
+    """
+    c = _finite(chi, "chi")
+    wa = _finite(w, "w")
+    na = _finite(n, "n")
+    if np.any(wa <= 0):
+        raise ValueError(f"w must be > 0, got {wa[wa <= 0].flat[0]!r}")
+    if np.any(na < 0):
+        raise ValueError(f"n must be >= 0, got {na[na < 0].flat[0]!r}")
+    return _rb08_v_ufunc(c, wa, na)
+
+
+def Vm(zeta: ArrayLike, zeta0: ArrayLike, w_a: ArrayLike, w_b: ArrayLike, gamma: ArrayLike,
+       delta: ArrayLike, alpha: ArrayLike | None = None) -> np.ndarray:
+    """RB08 masking/shadowing multiplier ``Vm(zeta, zeta0, w_a, w_b, gamma, delta)`` (Eq. 13).
+
+    With the recommended signs (MODELS.md §4.8) ``E0 = exp(-gamma zeta0 exp(-delta zeta0²))``
+    and ``B = exp(-w_a zeta exp(-w_b alpha²))``::
+
+        Vm = 1/2 (1 - E0) [Sgn(zeta) + 1] + B {1/2 [1 - Sgn(zeta)] + 1/2 E0 [Sgn(zeta) + 1]}
+
+    i.e. ``B`` for ``zeta < 0``, ``1 - E0 (1 - B)`` for ``zeta > 0`` and 1 at ``zeta = 0``.
+    ``alpha`` is the direction cosine in B's exponent; by default ``sin(zeta)``, its in-plane
+    value under the recommended reading (zeta = signed in-plane scattering angle, radians).
+    ``E0 <= 1`` (hence ``Vm > 0``) needs ``gamma zeta0 >= 0``. Arrays broadcast.
+
+    Examples
+    --------
+    >>> import roughbrdf as rb
+    >>> float(rb.shadowing.Vm(0.0, 0.5, 1.0, 1.0, 1.0, 1.0))   # continuous, Vm(0) = 1
+    1.0
+    """
+    z = _finite(zeta, "zeta")
+    al = np.sin(z) if alpha is None else _finite(alpha, "alpha")
+    return _rb08_vm_ufunc(z, _finite(zeta0, "zeta0"), al, _finite(w_a, "w_a"),
+                          _finite(w_b, "w_b"), _finite(gamma, "gamma"), _finite(delta, "delta"))

@@ -1,0 +1,979 @@
+"""Fitting models to measurements: :func:`fit` and :class:`FitResult`.
+
+Data flows one way: file -> :func:`roughbrdf.read` -> :class:`~roughbrdf.measurement.Measurement`
+-> :func:`fit` -> :class:`FitResult` -> report, JSON, plots. Models know nothing about fitting: the
+fitter reads ``model.parameters`` (value, bounds) and rebuilds the model with
+``model.with_values``.
+
+What is minimized
+-----------------
+For each channel, ``scipy.optimize.least_squares`` (``method="trf"``, box bounds) minimizes
+``sum(r_i^2)`` with one residual per sample:
+
+``relative`` (default)
+    ``r = w (x - f)/f`` -- Trowbridge & Reitz's measure; the r.m.s. of ``(x - f)/f`` is their
+    ``sigma`` (TR75 Eq. 34, MODELS.md §3.9).
+``log``
+    ``r = w (ln x - ln f)``.
+``absolute``
+    ``r = w (x - f)``.
+
+``x`` is the measured value, ``f`` the model value of the *same quantity*: the model BRDF for
+``brdf`` data, BRDF·cos(theta_r) (TR75's BRIDF) for ``brdf_cos``/``bridf`` data. A ``relative``
+measurement has no absolute scale: it is compared with the model BRDF or BRIDF (option
+``relative_to``; default ``measurement.meta["relative_to"]`` if the file says, else ``"brdf"``)
+through a free scale ``K`` (``x -> K x``), solved in closed form at every residual evaluation
+(MODELS.md §3.9 reading (a)); for the relative loss ``K = sum(w^2 q)/sum(w^2 q^2)`` with
+``q = x/f``, which minimizes TR75's sigma exactly. ``K`` is therefore not an optimizer variable,
+but it is counted as a fitted parameter in the statistics, and its standard error is reported.
+
+Global search and speed
+-----------------------
+Each channel is fitted on its own. ``starts`` starting points are used: the model's current
+values, then scrambled Sobol points in the bounds of the free parameters
+(:class:`scipy.stats.qmc.Sobol`), plus the best point of the previous channel when several channels
+are fitted (a warm start; every channel still gets all its own starts). When a channel has more
+than ``subsample`` samples, the local fits from the starts run on a fixed random subsample of that
+size, and the ``polish`` best distinct end points are then refined on all samples; the best of
+those is the result. The Jacobian is a forward finite difference computed through the compiled
+model kernel: one vectorized model evaluation per free parameter (never a Python loop over
+samples). The final covariance uses a central-difference Jacobian on all samples.
+
+Uncertainties
+-------------
+``covar = (J^T J)^-1 * chi2/(N - n_varys)``, with ``J`` the Jacobian of the residuals at the optimum
+(free parameters, plus the scale ``K`` when it is free), i.e. scaled by the residual variance as
+lmfit does by default (``scale_covar=True``): the stderr assume the residuals' spread is the noise.
+``stderr = sqrt(diag(covar))``; ``correl`` is ``covar`` normalized. A singular ``J^T J`` gives
+``nan`` stderr and says so in the message.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+import time
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.stats import qmc
+
+from .measurement import Measurement
+from .models.base import Model
+from .models.base import model as _make_model
+
+__all__ = ["fit", "FitResult", "ChannelFit", "LOSSES"]
+
+#: residual definitions accepted by :func:`fit`
+LOSSES = ("relative", "log", "absolute")
+
+_EPS_STEP = math.sqrt(np.finfo(float).eps)  # forward-difference step (relative)
+_CENTRAL_STEP = np.finfo(float).eps ** (1.0 / 3.0)  # central-difference step (relative)
+# Floor applied to model values before dividing or taking logs, relative to the largest |x|:
+# a model value of exactly 0 (e.g. an underflowed Beckmann lobe) must not give inf.
+_F_FLOOR = 1e-12
+# Residuals that are still not finite (a model that overflows at some trial parameters) are
+# replaced by this value, so that the optimizer sees a large, finite cost and steps back.
+_BAD_RESIDUAL = 1e6
+_EXPLORE_TOL = 1e-8
+_X_SCALE = "jac"
+
+
+# ---------------------------------------------------------------------------------------------
+# one channel's objective
+# ---------------------------------------------------------------------------------------------
+class _Objective:
+    """Residuals of one channel (or a subsample of it) as a function of the free parameters."""
+
+    def __init__(self, base: Model, free: list[str], lo: np.ndarray, hi: np.ndarray,
+                 ti: np.ndarray, tr: np.ndarray, ph: np.ndarray, gamma: np.ndarray,
+                 x: np.ndarray, w: np.ndarray | None, flag: int, loss: str, free_scale: bool):
+        self.base, self.free, self.lo, self.hi = base, free, lo, hi
+        self.ti, self.tr, self.ph, self.flag = ti, tr, ph, flag
+        self.gamma = gamma
+        self.x, self.w, self.loss, self.free_scale = x, w, loss, free_scale
+        self.w2 = None if w is None else w * w
+        self.floor = _F_FLOOR * max(float(np.max(np.abs(x))), 1e-300)
+        self.logx = np.log(x) if loss == "log" else None
+        self.n = x.size
+        self.nfev = 0
+        self._last: tuple[np.ndarray, np.ndarray] | None = None
+
+    # model ------------------------------------------------------------------------------------
+    def model_at(self, theta: np.ndarray) -> Model:
+        return self.base.with_values(self.free, [float(t) for t in theta])
+
+    def values(self, theta: np.ndarray) -> np.ndarray:
+        """Model values at the samples (one call of the compiled kernel)."""
+        self.nfev += 1
+        return np.asarray(self.model_at(theta)._evaluate(self.ti, self.tr, self.ph, self.gamma,
+                                                         self.flag), dtype=float)
+
+    # residuals --------------------------------------------------------------------------------
+    def _sum(self, a: np.ndarray) -> float:
+        return float(a.sum() if self.w2 is None else (self.w2 * a).sum())
+
+    def scale(self, f: np.ndarray) -> float:
+        """Closed-form scale K of the data (``x -> K x``) for the model values ``f``."""
+        if not self.free_scale:
+            return 1.0
+        fs = np.maximum(f, self.floor)
+        x = self.x
+        if self.loss == "relative":
+            q = x / fs
+            den = self._sum(q * q)
+            k = self._sum(q) / den if den > 0 else 1.0
+        elif self.loss == "absolute":
+            den = self._sum(x * x)
+            k = self._sum(x * fs) / den if den > 0 else 1.0
+        else:  # log: ln K = weighted mean of (ln f - ln x)
+            wsum = float(self.n if self.w2 is None else self.w2.sum())
+            k = math.exp(self._sum(np.log(fs) - self.logx) / wsum)
+        return k if math.isfinite(k) and k > 0 else 1.0
+
+    def residual_of(self, f: np.ndarray, k: float | None = None) -> np.ndarray:
+        if k is None:
+            k = self.scale(f)
+        fs = np.maximum(f, self.floor)
+        if self.loss == "relative":
+            r = (k * self.x) / fs - 1.0
+        elif self.loss == "absolute":
+            r = k * self.x - f
+        else:
+            r = self.logx + math.log(k) - np.log(fs)
+        if self.w is not None:
+            r = r * self.w
+        if not np.isfinite(r).all():
+            r = np.where(np.isfinite(r), r, _BAD_RESIDUAL)
+        return r
+
+    def fun(self, theta: np.ndarray) -> np.ndarray:
+        r = self.residual_of(self.values(theta))
+        self._last = (np.array(theta, dtype=float), r)
+        return r
+
+    def _step(self, theta: np.ndarray, j: int, rel: float) -> float:
+        span = self.hi[j] - self.lo[j]
+        h = rel * max(abs(theta[j]), 1e-3 * span if math.isfinite(span) else 1e-3, 1e-8)
+        if theta[j] + h > self.hi[j]:
+            h = -h
+        return h
+
+    def jac(self, theta: np.ndarray, k: float | None = None) -> np.ndarray:
+        """Forward-difference Jacobian: one compiled model evaluation per free parameter.
+
+        With ``k=None`` the scale is re-solved at each perturbed point (the Jacobian of the
+        profiled residual the optimizer sees); with ``k`` given it is held fixed.
+        """
+        theta = np.asarray(theta, dtype=float)
+        if k is None and self._last is not None and np.array_equal(self._last[0], theta):
+            r0 = self._last[1]
+        else:
+            r0 = self.residual_of(self.values(theta), k)
+        out = np.empty((self.n, theta.size))
+        for j in range(theta.size):
+            h = self._step(theta, j, _EPS_STEP)
+            t = theta.copy()
+            t[j] += h
+            out[:, j] = (self.residual_of(self.values(t), k) - r0) / h
+        return out
+
+    def jac_central(self, theta: np.ndarray, k: float) -> np.ndarray:
+        """Central-difference Jacobian at fixed scale ``k`` (for the covariance)."""
+        out = np.empty((self.n, theta.size))
+        for j in range(theta.size):
+            h = abs(self._step(theta, j, _CENTRAL_STEP))
+            lo_ok = theta[j] - h >= self.lo[j]
+            hi_ok = theta[j] + h <= self.hi[j]
+            tp, tm = theta.copy(), theta.copy()
+            if lo_ok and hi_ok:
+                tp[j] += h
+                tm[j] -= h
+                d = 2 * h
+            elif hi_ok:
+                tp[j] += h
+                d = h
+            else:
+                tm[j] -= h
+                d = h
+            out[:, j] = (self.residual_of(self.values(tp), k)
+                         - self.residual_of(self.values(tm), k)) / d
+        return out
+
+    def scale_column(self, f: np.ndarray, k: float) -> np.ndarray:
+        """d r / d K at fixed model values (analytic)."""
+        fs = np.maximum(f, self.floor)
+        if self.loss == "relative":
+            col = self.x / fs
+        elif self.loss == "absolute":
+            col = self.x.copy()
+        else:
+            col = np.full(self.n, 1.0 / k)
+        return col if self.w is None else col * self.w
+
+
+# ---------------------------------------------------------------------------------------------
+# results
+# ---------------------------------------------------------------------------------------------
+@dataclass
+class ChannelFit:
+    """The fit of one channel (lmfit ``MinimizerResult``-like).
+
+    Attributes
+    ----------
+    channel : str
+        Channel label.
+    model : Model
+        The fitted model.
+    params : dict
+        Every parameter of the model (fitted, fixed and switched off) -> value.
+    free : list of str
+        Names of the fitted parameters.
+    init : dict
+        Starting values of the free parameters (the model's values before the fit).
+    bounds : dict
+        ``name -> (low, high)`` used for the free parameters.
+    stderr : dict
+        ``name -> standard error`` (``None`` for fixed parameters, ``nan`` if not estimable).
+    correl : dict
+        ``name -> {other: correlation}`` among the free parameters (and ``"scale"``).
+    covar : numpy.ndarray
+        Covariance of ``free`` (+ ``scale`` last if it is free).
+    scale, scale_stderr : float
+        The data scale ``K`` (``x -> K x``; 1 and 0 when the data are absolute).
+    success : bool
+    message : str
+    sigma : float
+        TR75 sigma: r.m.s. of ``(K x - f)/f`` over the fitted samples (Eq. 34).
+    rms_log : float
+        r.m.s. of ``ln(K x) - ln f`` over the fitted samples with ``x > 0``.
+    chi2, redchi, aic, bic : float
+        ``sum(r^2)`` of the loss residuals, ``chi2/(N - n_varys)``, and lmfit's
+        ``N ln(chi2/N) + 2 n_varys`` and ``N ln(chi2/N) + ln(N) n_varys``.
+    n_points, n_varys : int
+    excluded : dict
+        Samples left out or changed, by reason (``nonfinite``, ``negative``, ``clipped``,
+        ``zero_weight``, ``model_domain``).
+    nfev : int
+        Model evaluations (each one vectorized over all samples of the stage).
+    starts : list of dict
+        Every start: ``{"x0": ..., "cost": ..., "stage": "explore"|"full"}``.
+    elapsed : float
+        Seconds.
+    index : numpy.ndarray
+        Indices (into the measurement) of the fitted samples.
+    data : numpy.ndarray
+        The fitted values (after ``negative="clip"``), in the measurement's own scale.
+    fitted : numpy.ndarray
+        The model at those samples (the quantity compared).
+    residual : numpy.ndarray
+        The loss residuals at the optimum.
+    """
+
+    channel: str
+    model: Model
+    params: dict[str, float | None]
+    free: list[str]
+    init: dict[str, float]
+    bounds: dict[str, tuple[float, float]]
+    stderr: dict[str, float | None]
+    correl: dict[str, dict[str, float]]
+    covar: np.ndarray
+    scale: float
+    scale_stderr: float
+    success: bool
+    message: str
+    sigma: float
+    rms_log: float
+    chi2: float
+    redchi: float
+    aic: float
+    bic: float
+    n_points: int
+    n_varys: int
+    excluded: dict[str, int]
+    nfev: int
+    starts: list[dict[str, Any]]
+    elapsed: float
+    free_scale: bool
+    index: np.ndarray = field(repr=False)
+    data: np.ndarray = field(repr=False)
+    fitted: np.ndarray = field(repr=False)
+    residual: np.ndarray = field(repr=False)
+
+    @property
+    def metrics(self) -> dict[str, float | int]:
+        """The figures of merit, as in ``fit.json``."""
+        return {"sigma": self.sigma, "rms_log": self.rms_log, "chi2": self.chi2,
+                "redchi": self.redchi, "aic": self.aic, "bic": self.bic,
+                "n_points": self.n_points, "n_varys": self.n_varys}
+
+
+def _clean(v: Any) -> Any:
+    """JSON-safe copy: NaN/inf -> None, numpy scalars -> Python."""
+    if isinstance(v, dict):
+        return {str(k): _clean(x) for k, x in v.items()}
+    if isinstance(v, list | tuple):
+        return [_clean(x) for x in v]
+    if isinstance(v, np.ndarray):
+        return _clean(v.tolist())
+    if isinstance(v, np.integer):
+        return int(v)
+    if isinstance(v, float | np.floating):
+        v = float(v)
+        return v if math.isfinite(v) else None
+    return v
+
+
+def _fmt(v: float | None, digits: int = 6) -> str:
+    if v is None:
+        return "None"
+    if not math.isfinite(v):
+        return str(v)
+    return f"{v:.{digits}g}"
+
+
+@dataclass
+class FitResult:
+    """Result of :func:`fit`: one :class:`ChannelFit` per fitted channel.
+
+    ``res[label]`` or ``res[i]`` gives a channel. For a fit of a single channel, ``model``,
+    ``params``, ``stderr``, ``correl``, ``sigma``, ``rms_log`` and ``message`` are that channel's;
+    with several channels they raise and point to ``res[...]``. ``success`` is true when every
+    channel succeeded.
+    """
+
+    channels: list[ChannelFit]
+    measurement: Measurement = field(repr=False)
+    model_name: str
+    loss: str
+    compared: str
+    relative_to: str | None
+    options: dict[str, Any]
+    elapsed: float
+
+    # single-channel shortcuts -------------------------------------------------------------------
+    def _one(self, what: str) -> ChannelFit:
+        if len(self.channels) != 1:
+            labels = ", ".join(repr(c.channel) for c in self.channels)
+            raise AttributeError(
+                f"this fit has {len(self.channels)} channels ({labels}); use "
+                f"res[channel].{what} or res.channels[i].{what}")
+        return self.channels[0]
+
+    @property
+    def model(self) -> Model:
+        return self._one("model").model
+
+    @property
+    def params(self) -> dict[str, float | None]:
+        return self._one("params").params
+
+    @property
+    def stderr(self) -> dict[str, float | None]:
+        return self._one("stderr").stderr
+
+    @property
+    def correl(self) -> dict[str, dict[str, float]]:
+        return self._one("correl").correl
+
+    @property
+    def sigma(self) -> float:
+        return self._one("sigma").sigma
+
+    @property
+    def rms_log(self) -> float:
+        return self._one("rms_log").rms_log
+
+    @property
+    def message(self) -> str:
+        return self._one("message").message
+
+    @property
+    def success(self) -> bool:
+        return all(c.success for c in self.channels)
+
+    def __getitem__(self, key: int | str) -> ChannelFit:
+        if isinstance(key, str):
+            for c in self.channels:
+                if c.channel == key:
+                    return c
+            raise KeyError(f"no channel {key!r}; fitted: {[c.channel for c in self.channels]}")
+        return self.channels[key]
+
+    def __len__(self) -> int:
+        return len(self.channels)
+
+    def __iter__(self):
+        return iter(self.channels)
+
+    # output ---------------------------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """The ``fit.json`` content (keys ``model``, ``file``, ``loss``, ``channels`` ...)."""
+        meta = self.measurement.meta
+        chans = []
+        for c in self.channels:
+            chans.append({
+                "channel": c.channel,
+                "params": c.params,
+                "stderr": c.stderr,
+                "success": bool(c.success),
+                "metrics": c.metrics,
+                "message": c.message,
+                "free": c.free,
+                "init": c.init,
+                "bounds": {k: list(v) for k, v in c.bounds.items()},
+                "scale": c.scale,
+                "scale_stderr": c.scale_stderr,
+                "correl": c.correl,
+                "excluded": c.excluded,
+                "nfev": c.nfev,
+                "elapsed_s": c.elapsed,
+                "model_spec": c.model.to_dict(),
+            })
+        return _clean({
+            "model": self.model_name,
+            "file": meta.get("file"),
+            "loss": self.loss,
+            "quantity": self.measurement.quantity,
+            "compared": self.compared,
+            "relative_to": self.relative_to,
+            "sample": meta.get("sample"),
+            "options": self.options,
+            "elapsed_s": self.elapsed,
+            "channels": chans,
+        })
+
+    def to_json(self, path: str | None = None, *, indent: int = 2) -> str:
+        """JSON text of :meth:`to_dict` (strict JSON: NaN written as ``null``); optionally saved."""
+        text = json.dumps(self.to_dict(), indent=indent, allow_nan=False)
+        if path is not None:
+            with open(path, "w", encoding="utf-8") as fh:
+                fh.write(text + "\n")
+        return text
+
+    def report(self, *, min_correl: float = 0.1) -> str:
+        """lmfit-style text report of every channel."""
+        meta = self.measurement.meta
+        src = meta.get("file") or meta.get("sample") or "<measurement in memory>"
+        loss_txt = {"relative": "relative, (x - f)/f  (TR75 Eq. 34)",
+                    "log": "log, ln x - ln f", "absolute": "absolute, x - f"}[self.loss]
+        comp = f"model {self.compared}"
+        if self.relative_to:
+            comp += " (relative data: free scale K, x -> K x, closed form)"
+        lines = [f"[[Fit]] {self.model_name} to {src}",
+                 f"    data quantity      = {self.measurement.quantity}",
+                 f"    compared with      = {comp}",
+                 f"    loss               = {loss_txt}",
+                 f"    channels           = {len(self.channels)}",
+                 f"    time               = {self.elapsed:.3g} s"]
+        for c in self.channels:
+            lines.append("")
+            lines.append(f"[[Channel {c.channel}]]")
+            exc = ", ".join(f"{v} {k}" for k, v in c.excluded.items() if v) or "none"
+            nst = len([s for s in c.starts if s["stage"] != "full"])
+            lines += [
+                f"    success            = {c.success}  ({c.message})",
+                f"    # data points      = {c.n_points}  (left out / changed: {exc})",
+                f"    # variables        = {c.n_varys}"
+                + ("  (including the scale K)" if c.free_scale else ""),
+                f"    # starts           = {nst}",
+                f"    # model evals      = {c.nfev}",
+                f"    chi-square         = {_fmt(c.chi2)}",
+                f"    reduced chi-square = {_fmt(c.redchi)}",
+                f"    Akaike info crit   = {_fmt(c.aic)}",
+                f"    Bayesian info crit = {_fmt(c.bic)}",
+                f"    TR75 sigma         = {_fmt(c.sigma, 4)}   (r.m.s. of (Kx - f)/f)",
+                f"    r.m.s. log resid.  = {_fmt(c.rms_log, 4)}",
+                "[[Variables]]",
+            ]
+            width = max(len(n) for n in [*c.params, "scale K"])
+            for name, val in c.params.items():
+                if name in c.free:
+                    se = c.stderr.get(name)
+                    if se is not None and math.isfinite(se) and val:
+                        pct = f" ({100 * se / abs(val):.2f}%)"
+                    else:
+                        pct = ""
+                    lo, hi = c.bounds[name]
+                    txt = (f"{_fmt(val, 7)} +/- {_fmt(se, 4)}{pct} (init = {_fmt(c.init[name])}, "
+                           f"bounds [{_fmt(lo)}, {_fmt(hi)}])")
+                elif val is None:
+                    txt = "None (switched off)"
+                else:
+                    txt = f"{_fmt(val, 7)} (fixed)"
+                lines.append(f"    {name:<{width}}: {txt}")
+            if c.free_scale:
+                lines.append(f"    {'scale K':<{width}}: {_fmt(c.scale, 7)} +/- "
+                             f"{_fmt(c.scale_stderr, 4)} (closed form)")
+            pairs = []
+            names = list(c.correl)
+            for i, a in enumerate(names):
+                for b in names[i + 1:]:
+                    v = c.correl[a].get(b)
+                    if v is not None and math.isfinite(v) and abs(v) >= min_correl:
+                        pairs.append((abs(v), a, b, v))
+            if pairs:
+                lines.append(f"[[Correlations]] (unreported correlations are < {min_correl:.3f})")
+                for _, a, b, v in sorted(pairs, reverse=True):
+                    lines.append(f"    C({a}, {b}) = {v:+.4f}")
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.report()
+
+    def plot_data(self, channel: int | str = 0) -> tuple[Model, Measurement]:
+        """The fitted model and the fitted samples of one channel on the model's absolute scale.
+
+        Relative data are multiplied by the fitted ``K`` and labelled with the quantity they were
+        compared with (``brdf`` or ``bridf``), so that data and model share one axis.
+        """
+        c = self[channel] if isinstance(channel, str) else self.channels[channel]
+        meas = self.measurement.subset(c.index).select_channel(c.channel)
+        q = self.compared if self.compared in ("brdf", "bridf") else self.measurement.quantity
+        meas = replace(meas, values=(c.scale * c.data)[:, None],
+                       quantity="bridf" if q in ("bridf", "brdf_cos") else "brdf",
+                       uncertainty=None, meta=dict(meas.meta))
+        return c.model, meas
+
+    def plot(self, channel: int | str = 0, *, fig: Any = None) -> tuple[Any, Any]:
+        """Data vs model (in-plane slices per incidence) and the residual map of one channel.
+
+        Uses :func:`roughbrdf.plot.plot_comparison` and :func:`roughbrdf.plot.plot_residual_map`;
+        returns ``(fig, (ax_comparison, ax_residuals))``.
+        """
+        import matplotlib.pyplot as plt
+
+        from . import plot as rbplot
+
+        model, meas = self.plot_data(channel)
+        if fig is None:
+            fig = plt.figure(figsize=(12, 5))
+        ax1 = fig.add_subplot(1, 2, 1)
+        ax2 = fig.add_subplot(1, 2, 2)
+        rbplot.plot_comparison(model, meas, channel=0, ax=ax1)
+        rbplot.plot_residual_map(model, meas, channel=0, ax=ax2)
+        fig.tight_layout()
+        return fig, (ax1, ax2)
+
+
+# ---------------------------------------------------------------------------------------------
+# the fit
+# ---------------------------------------------------------------------------------------------
+def _model_label(m: Model) -> str:
+    comps = getattr(m, "components", None)
+    return "+".join(c.name for c in comps) if comps else m.name
+
+
+def _sobol(d: int, n: int, seed: Any) -> np.ndarray:
+    if n <= 0:
+        return np.empty((0, d))
+    sampler = qmc.Sobol(d, scramble=True, seed=seed)
+    m = max(0, math.ceil(math.log2(n)))
+    return sampler.random_base2(m)[:n]
+
+
+def _resolve_quantity(meas: Measurement, relative_to: str | None) -> tuple[int, str, str | None]:
+    """(flag, compared quantity name, relative_to) for the measurement's quantity."""
+    q = meas.quantity
+    if q == "brdf":
+        return 0, "brdf", None
+    if q in ("brdf_cos", "bridf"):
+        return 1, "bridf", None
+    rel = relative_to or meas.meta.get("relative_to") or "brdf"
+    rel = {"brdf_cos": "bridf"}.get(str(rel).lower(), str(rel).lower())
+    if rel not in ("brdf", "bridf"):
+        raise ValueError(f"relative_to must be 'brdf' or 'bridf' (what the relative values are "
+                         f"proportional to), got {rel!r}")
+    return (1 if rel == "bridf" else 0), rel, rel
+
+
+def _free_parameters(model: Model, fix: Iterable[str], bounds: Mapping[str, Sequence[float]] | None
+                     ) -> tuple[list[str], np.ndarray, np.ndarray, np.ndarray]:
+    names = model.param_names
+    fix = [fix] if isinstance(fix, str) else list(fix)
+    for nm in [*fix, *(bounds or {})]:
+        if nm not in names:
+            model.with_values([nm], [0.0])  # raises the registry's "unknown parameter" error
+    specs = {p.name: p for p in model.parameters}
+    free = [n for n in names if n not in fix and specs[n].value is not None]
+    if not free:
+        off = [n for n in names if specs[n].value is None]
+        extra = f" ({', '.join(off)} switched off by None)" if off else ""
+        raise ValueError(f"every parameter of {_model_label(model)} is fixed{extra}: nothing to "
+                         f"fit; free at least one of {names}")
+    lo = np.empty(len(free))
+    hi = np.empty(len(free))
+    x0 = np.empty(len(free))
+    for j, nm in enumerate(free):
+        b = (bounds or {}).get(nm, specs[nm].bounds)
+        lo[j], hi[j] = float(b[0]), float(b[1])
+        if not lo[j] < hi[j]:
+            raise ValueError(f"bounds of {nm!r} must satisfy low < high, got {tuple(b)}")
+        x0[j] = float(specs[nm].value)
+        if not lo[j] <= x0[j] <= hi[j]:
+            raise ValueError(f"starting value {nm} = {x0[j]:g} is outside its bounds "
+                             f"[{lo[j]:g}, {hi[j]:g}]; pass bounds={{{nm!r}: (low, high)}} or "
+                             f"another starting value")
+    return free, lo, hi, x0
+
+
+def _channel_weights(weights: Any, meas: Measurement, j: int, x: np.ndarray, loss: str
+                     ) -> np.ndarray | None:
+    if weights is None:
+        return None
+    n = meas.n_samples
+    if isinstance(weights, str):
+        if weights != "uncertainty":
+            raise ValueError(f"weights must be None, an array or 'uncertainty', got {weights!r}")
+        if meas.uncertainty is None:
+            raise ValueError("weights='uncertainty' but the measurement has no uncertainty")
+        u = meas.uncertainty[:, j]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            # absolute: 1/u; relative and log: x/u, the inverse relative uncertainty
+            w = 1.0 / u if loss == "absolute" else np.abs(x) / u
+        return np.where(np.isfinite(w) & (u > 0), w, 0.0)
+    w = np.asarray(weights, dtype=float)
+    if w.ndim == 2:
+        if w.shape != meas.values.shape:
+            raise ValueError(f"weights of shape {w.shape} do not match the values "
+                             f"{meas.values.shape}")
+        w = w[:, j]
+    w = np.broadcast_to(w, (n,)).astype(float)
+    if not np.all(np.isfinite(w)) or np.any(w < 0):
+        raise ValueError("weights must be finite and >= 0")
+    return w
+
+
+def _where(meas: Measurement, label: str) -> str:
+    f = meas.meta.get("file")
+    return f"{f}, channel {label!r}" if f else f"channel {label!r}"
+
+
+def _prepare_channel(model: Model, meas: Measurement, j: int, flag: int, loss: str, weights: Any,
+                     nonfinite: str, negative: str):
+    """Select the samples of channel ``j`` that enter the fit; count everything left out."""
+    label = meas.channels[j]
+    x = meas.values[:, j].astype(float).copy()
+    keep = np.ones(x.size, dtype=bool)
+    excluded = {"nonfinite": 0, "negative": 0, "clipped": 0, "zero_weight": 0,
+                "model_domain": 0}
+    bad = ~np.isfinite(x)
+    if bad.any():
+        if nonfinite == "raise":
+            rows = np.flatnonzero(bad)
+            show = ", ".join(str(r) for r in rows[:8]) + (" ..." if rows.size > 8 else "")
+            raise ValueError(f"{_where(meas, label)}: {rows.size} non-finite value(s) at "
+                             f"sample(s) {show}; pass nonfinite='drop' to fit without them")
+        keep &= ~bad
+        excluded["nonfinite"] = int(bad.sum())
+    # the log loss cannot use zeros either: "negative" handling covers x <= 0 there
+    neg = np.isfinite(x) & ((x <= 0) if loss == "log" else (x < 0))
+    if neg.any():
+        if negative == "keep":
+            if loss == "log":
+                raise ValueError(f"{_where(meas, label)}: the log loss needs positive values "
+                                 f"but {int(neg.sum())} are <= 0; pass negative='drop' or "
+                                 f"negative='clip'")
+        elif negative == "drop":
+            keep &= ~neg
+            excluded["negative"] = int(neg.sum())
+        else:  # clip
+            pos = x[np.isfinite(x) & (x > 0)]
+            x[neg] = (pos.min() if pos.size else 1.0) if loss == "log" else 0.0
+            excluded["clipped"] = int(neg.sum())
+    w = _channel_weights(weights, meas, j, x, loss)
+    if w is not None:
+        zero = keep & (w == 0)
+        excluded["zero_weight"] = int(zero.sum())
+        keep &= w > 0
+    if not model.grazing_incidence:
+        graze = keep & (meas.theta_i >= 0.5 * math.pi)
+        excluded["model_domain"] += int(graze.sum())
+        keep &= ~graze
+    # samples where the model itself is not finite at the starting values (e.g. the BRDF of the
+    # unshadowed TR75 model at theta_r = 90 deg, which is +inf): these cannot be fitted
+    idx = np.flatnonzero(keep)
+    if idx.size:
+        gam = (np.asarray(np.nan) if meas.polarization is None
+               else np.ascontiguousarray(meas.polarization[idx]))
+        f0 = np.asarray(model._evaluate(meas.theta_i[idx], meas.theta_r[idx], meas.phi[idx],
+                                        gam, flag), dtype=float)
+        ok = np.isfinite(f0)
+        if not ok.all():
+            excluded["model_domain"] += int((~ok).sum())
+            keep[idx[~ok]] = False
+    idx = np.flatnonzero(keep)
+    if idx.size == 0:
+        total = int(x.size)
+        raise ValueError(f"{_where(meas, label)}: no data to fit ({total} samples; left out: "
+                         + ", ".join(f"{v} {k}" for k, v in excluded.items() if v) + ")"
+                         if total else f"{_where(meas, label)}: no data to fit (0 samples)")
+    return idx, x[idx], (None if w is None else w[idx]), excluded
+
+
+def _covariance(obj: _Objective, theta: np.ndarray, k: float, chi2: float, dof: int
+                ) -> tuple[np.ndarray, list[str], str]:
+    f = obj.values(theta)
+    cols = [obj.jac_central(theta, k)]
+    names = list(obj.free)
+    if obj.free_scale:
+        cols.append(obj.scale_column(f, k)[:, None])
+        names.append("scale")
+    jmat = np.hstack(cols)
+    note = ""
+    p = jmat.shape[1]
+    try:
+        _, s, vt = np.linalg.svd(jmat, full_matrices=False)
+        if not np.all(np.isfinite(s)) or s[0] == 0 or s[-1] <= s[0] * 1e-12:
+            raise np.linalg.LinAlgError("singular")
+        inv = (vt.T / (s * s)) @ vt
+        cov = inv * (chi2 / max(dof, 1))
+    except np.linalg.LinAlgError:
+        cov = np.full((p, p), np.nan)
+        note = "; covariance not estimated (singular J^T J: a parameter has no effect)"
+    return cov, names, note
+
+
+def fit(model: Model | str, measurement: Measurement, *,
+        channel: int | str | Sequence | None = None, loss: str = "relative",
+        weights: Any = None, fix: Iterable[str] = (),
+        bounds: Mapping[str, Sequence[float]] | None = None, starts: int = 8,
+        seed: int | None = 0, nonfinite: str = "raise", negative: str = "keep",
+        relative_to: str | None = None, free_scale: bool | None = None,
+        subsample: int | None = 2000, polish: int = 2, max_nfev: int | None = None,
+        progress: bool | None = None) -> FitResult:
+    """Fit ``model`` to ``measurement``, each channel on its own.
+
+    Parameters
+    ----------
+    model : Model or str
+        Model with starting values (``rb.model(...)``; sums allowed), or a registered name.
+    measurement : Measurement
+        The data (:func:`roughbrdf.read`).
+    channel : int, str, list or None
+        Channel(s) to fit (labels or positions); ``None`` fits every channel.
+    loss : {"relative", "log", "absolute"}
+        Residual: ``(x - f)/f`` (TR75 Eq. 34), ``ln x - ln f`` or ``x - f``; see the module notes.
+    weights : None, array or "uncertainty"
+        Multiplies each residual; shape (N,) or (N, C). ``"uncertainty"`` uses the measurement's
+        uncertainty ``u``: ``1/u`` for the absolute loss, ``x/u`` for the relative and log losses.
+        Samples of weight 0 are left out (and counted).
+    fix : iterable of str
+        Parameters kept at the model's value. Parameters whose value is ``None`` (parts switched
+        off, e.g. TS67 ``n=None``) are never fitted.
+    bounds : dict, optional
+        ``name -> (low, high)``, overriding the model's default search ranges.
+    starts : int
+        Starting points per channel: the model's values, then Sobol points in the bounds
+        (``starts=1`` is a plain local fit from the model's values).
+    seed : int or None
+        Seed of the scrambled Sobol sequence and of the subsample (results are reproducible).
+    nonfinite : {"raise", "drop"}
+        What to do with NaN/inf measured values.
+    negative : {"keep", "drop", "clip"}
+        What to do with negative measured values (non-positive ones for ``loss="log"``, where
+        ``keep`` raises). ``clip`` sets them to 0 (to the smallest positive value for the log
+        loss). Counts are reported in ``excluded``.
+    relative_to : {"brdf", "bridf"}, optional
+        For ``relative`` data: the model quantity the values are proportional to. Default
+        ``measurement.meta["relative_to"]`` if the reader found it, else ``"brdf"``.
+    free_scale : bool, optional
+        Fit a free scale ``K`` of the data in closed form. Default: only for ``relative`` data.
+    subsample : int or None
+        Above this many samples, the starts are explored on a fixed random subsample and the
+        ``polish`` best end points refined on all samples. ``None`` uses all samples throughout.
+    polish : int
+        Number of explored end points refined on the full data.
+    max_nfev : int, optional
+        Limit of function evaluations per local fit (``least_squares``).
+    progress : bool or None
+        Show a tqdm progress bar; ``None`` shows it only on an interactive terminal.
+
+    Returns
+    -------
+    FitResult
+
+    Raises
+    ------
+    ValueError
+        Unknown loss or option, every parameter fixed, no data left in a channel, non-finite
+        values with ``nonfinite="raise"``, non-positive values for the log loss with
+        ``negative="keep"``.
+    """
+    t_start = time.perf_counter()
+    if isinstance(model, str):
+        model = _make_model(model)
+    if not isinstance(model, Model):
+        raise TypeError(f"model must be a roughbrdf Model or a model name, got {type(model)}")
+    if not isinstance(measurement, Measurement):
+        raise TypeError(f"measurement must be a roughbrdf Measurement, got {type(measurement)}")
+    if loss not in LOSSES:
+        raise ValueError(f"unknown loss {loss!r}; choose one of {', '.join(LOSSES)}")
+    if nonfinite not in ("raise", "drop"):
+        raise ValueError(f"nonfinite must be 'raise' or 'drop', got {nonfinite!r}")
+    if negative not in ("keep", "drop", "clip"):
+        raise ValueError(f"negative must be 'keep', 'drop' or 'clip', got {negative!r}")
+    starts = int(starts)
+    if starts < 1:
+        raise ValueError(f"starts must be >= 1, got {starts}")
+    polish = max(1, int(polish))
+    meas = measurement
+    flag, compared, rel = _resolve_quantity(meas, relative_to)
+    if free_scale is None:
+        free_scale = meas.quantity == "relative"
+    free, lo, hi, x0 = _free_parameters(model, fix, bounds)
+    if channel is None:
+        chans = list(range(len(meas.channels)))
+    elif isinstance(channel, list | tuple):
+        chans = [meas.channel_index(c) for c in channel]
+    else:
+        chans = [meas.channel_index(channel)]
+    if not chans:
+        raise ValueError("no channel to fit")
+    rng = np.random.default_rng(seed)
+    sobol = _sobol(len(free), starts - 1, seed)
+    sobol_x = lo + sobol * (hi - lo)
+
+    # prepare every channel first, so that bad input fails before any work
+    prepared = [_prepare_channel(model, meas, j, flag, loss, weights, nonfinite, negative)
+                for j in chans]
+    n_varys = len(free) + (1 if free_scale else 0)
+    for j, (idx, _, _, _) in zip(chans, prepared, strict=True):
+        if idx.size <= n_varys:
+            raise ValueError(f"{_where(meas, meas.channels[j])}: {idx.size} samples for "
+                             f"{n_varys} fitted parameters; need more data than parameters")
+
+    pbar = None
+    if progress is None:
+        progress = bool(getattr(sys.stderr, "isatty", lambda: False)())
+    if progress:
+        from tqdm.auto import tqdm
+
+        pbar = tqdm(total=len(chans) * starts, desc=f"fit {_model_label(model)}", unit="start",
+                    leave=False)
+    results: list[ChannelFit] = []
+    warm: np.ndarray | None = None
+    try:
+        for j, (idx, x, w, excluded) in zip(chans, prepared, strict=True):
+            t0 = time.perf_counter()
+            label = meas.channels[j]
+            if pbar is not None:
+                pbar.set_postfix_str(label)
+            gam = (np.asarray(np.nan) if meas.polarization is None
+                   else np.ascontiguousarray(meas.polarization[idx]))
+            geo = (np.ascontiguousarray(meas.theta_i[idx]), np.ascontiguousarray(meas.theta_r[idx]),
+                   np.ascontiguousarray(meas.phi[idx]))
+            full = _Objective(model, free, lo, hi, *geo, gam, x, w, flag, loss, free_scale)
+            if subsample is not None and idx.size > subsample:
+                sub = np.sort(rng.choice(idx.size, size=int(subsample), replace=False))
+                explore = _Objective(model, free, lo, hi, *(g[sub] for g in geo),
+                                     gam if gam.ndim == 0 else gam[sub], x[sub],
+                                     None if w is None else w[sub], flag, loss, free_scale)
+            else:
+                explore = full
+            points = [x0] + ([warm] if warm is not None else []) + list(sobol_x)
+            kw = {"method": "trf", "x_scale": _X_SCALE, "max_nfev": max_nfev}
+            tried: list[dict[str, Any]] = []
+            ends: list[tuple[float, np.ndarray, Any]] = []
+            for p0 in points:
+                p0 = np.clip(p0, lo, hi)
+                res = least_squares(explore.fun, p0, jac=explore.jac, bounds=(lo, hi),
+                                    ftol=_EXPLORE_TOL, xtol=_EXPLORE_TOL, gtol=_EXPLORE_TOL, **kw)
+                tried.append({"x0": p0.tolist(), "x": res.x.tolist(), "cost": float(res.cost),
+                              "stage": "explore" if explore is not full else "single"})
+                ends.append((float(res.cost), res.x, res))
+                if pbar is not None:
+                    pbar.update(1)
+            ends.sort(key=lambda e: e[0])
+            if explore is full:
+                best_cost, best_x, best = ends[0]
+            else:
+                chosen: list[np.ndarray] = []
+                for _, xe, _ in ends:
+                    span = hi - lo
+                    if all(np.max(np.abs(xe - c) / span) > 1e-3 for c in chosen):
+                        chosen.append(xe)
+                    if len(chosen) == polish:
+                        break
+                best_cost, best_x, best = math.inf, chosen[0], None
+                for xe in chosen:
+                    res = least_squares(full.fun, xe, jac=full.jac, bounds=(lo, hi),
+                                        ftol=1e-9, xtol=1e-9, gtol=1e-9, **kw)
+                    tried.append({"x0": xe.tolist(), "x": res.x.tolist(),
+                                  "cost": float(res.cost), "stage": "full"})
+                    if res.cost < best_cost:
+                        best_cost, best_x, best = float(res.cost), res.x, res
+            warm = best_x.copy()
+            results.append(_finish(model, full, best_x, best, label, idx, x, excluded, free, lo,
+                                   hi, x0, tried, time.perf_counter() - t0,
+                                   0 if explore is full else explore.nfev))
+    finally:
+        if pbar is not None:
+            pbar.close()
+
+    return FitResult(channels=results, measurement=meas, model_name=_model_label(model),
+                     loss=loss, compared=compared, relative_to=rel,
+                     options={"starts": starts, "seed": seed, "subsample": subsample,
+                              "polish": polish, "nonfinite": nonfinite, "negative": negative,
+                              "free_scale": bool(free_scale),
+                              "fix": sorted(set(model.param_names) - set(free)),
+                              "weights": None if weights is None else
+                              (weights if isinstance(weights, str) else "array")},
+                     elapsed=time.perf_counter() - t_start)
+
+
+def _finish(model: Model, obj: _Objective, theta: np.ndarray, res: Any, label: str,
+            idx: np.ndarray, x: np.ndarray, excluded: dict[str, int], free: list[str],
+            lo: np.ndarray, hi: np.ndarray, x0: np.ndarray, tried: list[dict[str, Any]],
+            elapsed: float, extra_nfev: int) -> ChannelFit:
+    fitted_model = obj.model_at(theta)
+    f = obj.values(theta)
+    k = obj.scale(f)
+    r = obj.residual_of(f, k)
+    n = r.size
+    n_varys = len(free) + (1 if obj.free_scale else 0)
+    chi2 = float(r @ r)
+    dof = n - n_varys
+    redchi = chi2 / dof if dof > 0 else math.nan
+    lchi = math.log(chi2 / n) if chi2 > 0 else -math.inf
+    aic = n * lchi + 2 * n_varys
+    bic = n * lchi + math.log(n) * n_varys
+    fs = np.maximum(f, obj.floor)
+    rel = (k * x - f) / fs
+    sigma = float(np.sqrt(np.mean(rel * rel)))
+    pos = (x > 0) & (f > 0)
+    rms_log = (float(np.sqrt(np.mean((np.log(k * x[pos]) - np.log(f[pos])) ** 2)))
+               if pos.any() else math.nan)
+    cov, names, note = _covariance(obj, theta, k, chi2, dof)
+    sd = np.sqrt(np.where(np.diag(cov) >= 0, np.diag(cov), np.nan))
+    stderr: dict[str, float | None] = {nm: None for nm in model.param_names}
+    for nm, s in zip(names, sd, strict=True):
+        if nm != "scale":
+            stderr[nm] = float(s)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        corr = cov / np.outer(sd, sd)
+    correl = {a: {b: float(corr[i, m]) for m, b in enumerate(names) if m != i}
+              for i, a in enumerate(names)}
+    scale_se = float(sd[-1]) if obj.free_scale else 0.0
+    success = bool(res.success) if res is not None else False
+    message = (res.message if res is not None else "no local fit finished") + note
+    if np.any(np.isclose(theta, lo, rtol=0, atol=1e-9 * (hi - lo))
+              | np.isclose(theta, hi, rtol=0, atol=1e-9 * (hi - lo))):
+        at = [nm for nm, t, a, b in zip(free, theta, lo, hi, strict=True)
+              if abs(t - a) <= 1e-9 * (b - a) or abs(t - b) <= 1e-9 * (b - a)]
+        message += f"; at a bound: {', '.join(at)}"
+    return ChannelFit(
+        channel=label, model=fitted_model, params=fitted_model.params, free=list(free),
+        init={nm: float(v) for nm, v in zip(free, x0, strict=True)},
+        bounds={nm: (float(a), float(b)) for nm, a, b in zip(free, lo, hi, strict=True)},
+        stderr=stderr, correl=correl, covar=cov, scale=float(k), scale_stderr=scale_se,
+        success=success, message=message, sigma=sigma, rms_log=rms_log, chi2=chi2,
+        redchi=redchi, aic=aic, bic=bic, n_points=int(n), n_varys=n_varys, excluded=excluded,
+        nfev=obj.nfev + extra_nfev, starts=tried, free_scale=obj.free_scale,
+        elapsed=elapsed, index=idx, data=x, fitted=f, residual=r)
+

@@ -9,6 +9,7 @@ See ``roughbrdf.geometry`` for the conversions to each paper's own angles.
 """
 
 from . import distributions, fresnel, geometry, shadowing
+from .fitting import FitResult, fit
 from .integrate import albedo, reciprocity_error
 from .io import read, write
 from .models import Model, Parameter, SumModel, available, model
@@ -19,6 +20,8 @@ __all__ = [
     "albedo",
     "available",
     "distributions",
+    "fit",
+    "FitResult",
     "fresnel",
     "geometry",
     "model",

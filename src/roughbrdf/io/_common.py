@@ -118,7 +118,7 @@ def check_zenith_rows(values: np.ndarray, name: str, linenos, path, *, unit: str
     bad = ~np.isfinite(v)
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
-        raise FormatError(f"{name} is {v[k]!r} (an angle must be a finite number); "
+        raise FormatError(f"{name} is {float(v[k])!r} (an angle must be a finite number); "
                           f"{int(bad.sum())} such rows", path, int(linenos[k]))
     out = (v < -slack) | (v > HALF_PI + slack)
     if out.any():
@@ -127,7 +127,7 @@ def check_zenith_rows(values: np.ndarray, name: str, linenos, path, *, unit: str
         hint = ""
         if unit == "rad" and v[k] > 2 * math.pi:
             hint = " - the angles look like degrees; declare the unit (angles='deg')"
-        raise FormatError(f"{name} = {v[k]!r} rad ({shown:.6g} deg) is outside [0, 90] deg"
+        raise FormatError(f"{name} = {float(v[k])!r} rad ({shown:.6g} deg) is outside [0, 90] deg"
                           f"{hint}", path, int(linenos[k]))
     return np.clip(v, 0.0, HALF_PI)
 
@@ -138,7 +138,7 @@ def azimuth_rows(values: np.ndarray, name: str, linenos, path) -> np.ndarray:
     bad = ~np.isfinite(v)
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
-        raise FormatError(f"{name} is {v[k]!r} (an angle must be a finite number); "
+        raise FormatError(f"{name} is {float(v[k])!r} (an angle must be a finite number); "
                           f"{int(bad.sum())} such rows", path, int(linenos[k]))
     return v
 

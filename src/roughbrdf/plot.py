@@ -31,6 +31,7 @@ import numpy as np
 from matplotlib import colors as mcolors
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 from numpy.typing import ArrayLike
 
 from . import geometry
@@ -230,6 +231,9 @@ def plot_polar(model: Model, theta_i: float, elevation: float, *, n: int = 361,
         ax.plot(psi, y, ls=ls, color="k" if p in ("s", None) else "C3", label=name)
     ax.set_theta_zero_location("N")  # psi = 0 (toward the source) at the top
     ax.set_theta_direction(-1)
+    ax.set_thetagrids(range(0, 360, 45))
+    ax.yaxis.set_major_locator(MaxNLocator(4))
+    ax.set_rlabel_position(22.5)
     if rmax is not None:
         ax.set_rlim(0, rmax)
     ax.set_xlabel(r"azimuth $\psi$ (0° toward the source) [deg]", labelpad=4)
@@ -304,6 +308,12 @@ def _disk_decorations(ax: Axes) -> None:
 # --------------------------------------------------------------------------------------------
 # measurement vs model
 # --------------------------------------------------------------------------------------------
+def _relative_to_cos(meas: Measurement) -> bool:
+    """Relative data proportional to BRDF·cosθr (``meta["relative_to"]`` = bridf/brdf_cos)."""
+    return meas.quantity == "relative" and str(meas.meta.get("relative_to", "brdf")).lower() in (
+        "bridf", "brdf_cos")
+
+
 def _comparison_setup(model: Model, measurement: Measurement, channel: int | str
                       ) -> tuple[Measurement, np.ndarray, np.ndarray, str, float]:
     """Single channel; model values at the samples, matched to the data's quantity.
@@ -316,7 +326,7 @@ def _comparison_setup(model: Model, measurement: Measurement, channel: int | str
     data = meas.values[:, 0]
     q = meas.quantity
     pol = meas.polarization
-    if q in ("brdf_cos", "bridf"):
+    if q in ("brdf_cos", "bridf") or _relative_to_cos(meas):
         mod = model_values(model, meas.theta_i, meas.theta_r, meas.phi, "bridf", pol)
     else:
         mod = model_values(model, meas.theta_i, meas.theta_r, meas.phi, "brdf", pol)
@@ -354,7 +364,8 @@ def plot_comparison(model: Model, measurement: Measurement, *, channel: int | st
     Markers are the measured in-plane samples (``phi`` within 0.5° of 0 or 180°), lines the model
     at the same incidence (and polarization, if the data have one). The compared quantity follows
     ``measurement.quantity``: ``brdf`` against the model BRDF; ``brdf_cos``/``bridf`` against
-    BRDF·cosθr; ``relative`` against the model BRDF times the closed-form best scale ``K``
+    BRDF·cosθr; ``relative`` against the model BRDF (BRDF·cosθr when ``meta["relative_to"]`` is
+    ``bridf``) times the closed-form best scale ``K``
     (:func:`best_scale`, given in the title). The value axis is logarithmic when the data span
     more than a factor 30. A measurement with no in-plane samples is shown as a parity plot
     (model against data) instead.
@@ -384,7 +395,7 @@ def plot_comparison(model: Model, measurement: Measurement, *, channel: int | st
     cols = incidence_colors(len(incs))
     ts_grid = _signed_grid(361, 89.5)
     tr_g, ph_g = geometry.from_signed_angle(ts_grid)
-    curve_q = "bridf" if q in ("bridf", "brdf_cos") else "brdf"
+    curve_q = "bridf" if q in ("bridf", "brdf_cos") or _relative_to_cos(meas) else "brdf"
     groups = _pol_groups(inplane)
     markers = ["o", "s", "^", "D"]
     all_vals = []

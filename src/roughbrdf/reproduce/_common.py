@@ -1,0 +1,156 @@
+"""The result of one reproduction (figure + the numbers behind it) and how it is written."""
+
+from __future__ import annotations
+
+import csv
+import io
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.figure import Figure
+
+__all__ = ["Table", "Reproduction", "Unavailable", "new_figure", "check_writable", "save_png",
+           "DPI"]
+
+#: resolution of the written PNGs (small files; the docs commit them)
+DPI = 100
+
+
+class Unavailable(RuntimeError):
+    """A reproduction needs a part of the library this version does not have."""
+
+
+@dataclass
+class Table:
+    """A table of numbers: column names and rows (each row a sequence of numbers or strings)."""
+
+    columns: list[str]
+    rows: list[Sequence[Any]]
+
+    def column(self, name: str) -> np.ndarray:
+        """One column as an array (floats where possible)."""
+        j = self.columns.index(name)
+        vals = [r[j] for r in self.rows]
+        try:
+            return np.asarray(vals, dtype=float)
+        except (TypeError, ValueError):
+            return np.asarray(vals, dtype=object)
+
+    def to_csv(self) -> str:
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(self.columns)
+        for r in self.rows:
+            w.writerow([_fmt(v) for v in r])
+        return buf.getvalue()
+
+    def to_markdown(self) -> str:
+        lines = ["| " + " | ".join(self.columns) + " |",
+                 "|" + "|".join("---" for _ in self.columns) + "|"]
+        for r in self.rows:
+            lines.append("| " + " | ".join(_fmt(v, md=True) for v in r) + " |")
+        return "\n".join(lines) + "\n"
+
+
+def _fmt(v: Any, md: bool = False) -> str:
+    if isinstance(v, float | np.floating):
+        if not np.isfinite(v):
+            return "" if md else str(v)
+        return f"{float(v):.4f}" if md else f"{float(v):.10g}"
+    return str(v)
+
+
+@dataclass
+class Reproduction:
+    """One reproduced figure or table.
+
+    Attributes
+    ----------
+    name : str
+        File stem, e.g. ``"ts67_fig08"``; files are ``<name>.png``, ``<name>.csv`` (one table) or
+        ``<name>_<table>.csv`` (several), and ``<name>.md`` when ``markdown`` is set.
+    title : str
+        What the paper's figure shows.
+    figure : matplotlib.figure.Figure or None
+    tables : dict of str -> Table
+        The numbers behind the figure (every plotted or printed number).
+    markdown : str, optional
+        A Markdown rendering (tables).
+    notes : list of str
+        Where we differ from the paper and why.
+    """
+
+    name: str
+    title: str
+    figure: Figure | None = None
+    tables: dict[str, Table] = field(default_factory=dict)
+    markdown: str | None = None
+    notes: list[str] = field(default_factory=list)
+
+    def outputs(self, out: Path) -> list[Path]:
+        """The files :meth:`write` would create in ``out``."""
+        paths = []
+        if self.figure is not None:
+            paths.append(out / f"{self.name}.png")
+        for key in self.tables:
+            paths.append(out / (f"{self.name}.csv" if len(self.tables) == 1
+                                else f"{self.name}_{key}.csv"))
+        if self.markdown is not None:
+            paths.append(out / f"{self.name}.md")
+        return paths
+
+    def write(self, out: Path, *, force: bool = False, dpi: int = DPI,
+              compact: bool = False) -> list[Path]:
+        """Write the PNG, CSV(s) and Markdown into ``out``; refuse to overwrite unless ``force``.
+
+        ``compact`` stores the PNG with a 256-colour palette (about a third of the size; used
+        for the images committed under ``docs/img``).
+        """
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        paths = self.outputs(out)
+        check_writable(paths, force)
+        it = iter(paths)
+        if self.figure is not None:
+            save_png(self.figure, next(it), dpi=dpi, compact=compact)
+        for table in self.tables.values():
+            next(it).write_text(table.to_csv())
+        if self.markdown is not None:
+            next(it).write_text(self.markdown)
+        return paths
+
+
+def save_png(fig: Figure, path: Path, *, dpi: int = DPI, compact: bool = False) -> None:
+    """Save ``fig`` as PNG; ``compact`` quantizes to a 256-colour palette (Pillow)."""
+    if not compact:
+        fig.savefig(path, dpi=dpi, format="png")
+        return
+    from PIL import Image  # matplotlib depends on Pillow
+
+    buf = io.BytesIO()
+    fig.savefig(buf, dpi=dpi, format="png", facecolor="white")
+    buf.seek(0)
+    with Image.open(buf) as im:
+        im.convert("RGB").quantize(colors=256, method=Image.Quantize.MEDIANCUT).save(
+            path, format="PNG", optimize=True)
+
+
+def check_writable(paths: Sequence[Path], force: bool) -> None:
+    """Raise ``FileExistsError`` naming the first existing file unless ``force``."""
+    if force:
+        return
+    for p in paths:
+        if Path(p).exists():
+            raise FileExistsError(f"{p} exists; use --force (force=True) to overwrite")
+
+
+def new_figure(nrows: int = 1, ncols: int = 1, *, figsize: tuple[float, float] = (6.4, 4.8),
+               polar: bool = False, **kw: Any) -> tuple[Figure, Any]:
+    """A pyplot-free figure with a grid of axes (constrained layout)."""
+    fig = Figure(figsize=figsize, layout="constrained")
+    axes = fig.subplots(nrows, ncols, squeeze=False,
+                        subplot_kw={"projection": "polar"} if polar else None, **kw)
+    return fig, axes

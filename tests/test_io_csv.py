@@ -132,3 +132,11 @@ def test_writer_refuses_bad_channel_names(tmp_path):
     m.channels = ["a,b", "c"]
     with pytest.raises(ValueError, match="cannot be a CSV column"):
         rb.write(m, tmp_path / "x.csv")
+
+
+def test_relative_to_and_bom_survive(tmp_path):
+    text = "\ufeff" + GOOD.replace("# quantity: brdf", "# quantity: relative\n# relative_to: bridf")
+    m = rb.read(_write(tmp_path, text))
+    assert m.quantity == "relative" and m.meta["relative_to"] == "bridf"
+    rb.write(m, tmp_path / "again.csv")
+    assert rb.read(tmp_path / "again.csv").meta["relative_to"] == "bridf"

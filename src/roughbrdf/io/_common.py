@@ -44,7 +44,7 @@ def read_text(path: str | os.PathLike) -> list[str]:
         raise FileNotFoundError(f"{p}: no such file")
     if p.is_dir():
         raise FormatError("is a directory, not a measurement file", p)
-    with open(p, encoding="utf-8", errors="replace", newline=None) as fh:
+    with open(p, encoding="utf-8-sig", errors="replace", newline=None) as fh:
         return fh.read().splitlines()
 
 

@@ -19,6 +19,8 @@ Header (``#`` lines before the column names, each ``# key: value``):
   ``angles=``); a file with neither is refused;
 * ``# quantity: brdf|brdf_cos|bridf|relative`` - what the values hold (required, unless the
   single value column is named after a quantity, e.g. ``brdf``, or ``quantity=`` is given);
+* ``# relative_to: brdf|bridf`` - for ``relative`` data, whether the values are proportional to
+  the BRDF or to BRDF x cos(theta_r) (TR75's relative BRIDF); read by ``rb.fit``;
 * optional provenance: ``sample``, ``instrument``, ``date``, ``source_file``, ``source_format``
   and any other ``key: value`` (kept as strings in ``Measurement.meta``).
 
@@ -273,7 +275,7 @@ def write(measurement: Measurement, path: str | os.PathLike, *, angles: str = "d
                 cols.append(a.astype(float))
     head = [f"# {TAG} {VERSION}", f"# angles: {unit}", f"# quantity: {m.quantity}"]
     meta = m.meta
-    for key in ("sample", "instrument", "date"):
+    for key in ("sample", "instrument", "date", "relative_to"):
         if meta.get(key):
             head.append(f"# {key}: {_clean(meta[key])}")
     if meta.get("file"):

@@ -560,6 +560,41 @@ class FitResult:
         fig.tight_layout()
         return fig, (ax1, ax2)
 
+    def plot_names(self) -> list[str]:
+        """File names :meth:`save` gives the per-channel plots (``fit_<channel>.png``)."""
+        out = []
+        for c in self.channels:
+            safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in c.channel)
+            out.append(f"fit_{safe or 'channel'}.png")
+        return out
+
+    def save(self, out_dir: str | Any, *, plots: bool = True, force: bool = False,
+             dpi: int = 110) -> list[Any]:
+        """Write ``fit.json``, ``report.txt`` and one ``fit_<channel>.png`` per channel.
+
+        ``out_dir`` may exist. Files roughbrdf wrote there before are replaced; any other file of
+        the same name stops the call with ``FileExistsError`` before anything is written, unless
+        ``force=True`` (see :mod:`roughbrdf._outdir`). Returns the paths written.
+        """
+        from ._outdir import OutputDir
+
+        out = OutputDir(out_dir, force=force)
+        names = ["fit.json", "report.txt", *(self.plot_names() if plots else [])]
+        out.check(names)
+        written = [out.file("fit.json")]
+        self.to_json(str(written[0]))
+        written.append(out.write_text("report.txt", self.report()))
+        if plots:
+            import matplotlib.pyplot as plt
+
+            for i, name in enumerate(self.plot_names()):
+                fig, _ = self.plot(i)
+                path = out.file(name)
+                fig.savefig(path, dpi=dpi, metadata={"Software": "roughbrdf"})
+                plt.close(fig)
+                written.append(path)
+        return written
+
 
 # ---------------------------------------------------------------------------------------------
 # the fit

@@ -322,3 +322,55 @@ def test_run_and_cli(tmp_path):
     assert res.exit_code == 2 and "unknown paper" in res.output
     with pytest.raises(ValueError, match="unknown paper"):
         run("nope", out)
+
+
+# ---------------------------------------------------------------------------------------------
+# RB08
+# ---------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def rbr():
+    from roughbrdf.reproduce import Unavailable
+
+    try:
+        return {r.name: r for r in reproductions("rb08", skip_unavailable=False)}
+    except Unavailable as exc:  # pragma: no cover - only before the RB08 model exists
+        pytest.skip(str(exc))
+
+
+def test_rb08_fig2_vm_identities(rbr):
+    checks = rbr["rb08_fig02"].tables["checks"]
+    for row in checks.rows:
+        r = dict(zip(checks.columns, row, strict=True))
+        assert r["vm_at_0"] == pytest.approx(1.0, abs=1e-12)      # Vm(0) = 1
+        assert r["jump_at_0"] < 1e-6                              # continuous across zeta = 0
+        assert r["max_piecewise_error"] < 1e-12                   # B / 1 - E0 (1 - B)
+        assert 0.0 < r["E0"] <= 1.0
+    curves = rbr["rb08_fig02"].tables["curves"]
+    z = curves.column("zeta_deg")
+    a, b = (curves.column(f"vm_theta_i_{t:g}") for t in (20, 60))
+    np.testing.assert_allclose(a[z < 0], b[z < 0], rtol=0, atol=1e-15)  # Vm = B for zeta < 0
+    assert np.max(np.abs(a[z > 0] - b[z > 0])) > 1e-3                 # E0 differs for zeta > 0
+    assert np.all(np.isfinite(a)) and np.all(a > 0)
+
+
+def test_rb08_fig3_two_orders_of_magnitude(rbr):
+    rng = rbr["rb08_fig03"].tables["range"]
+    overall = rng.rows[-1]
+    assert overall[0] == "all" and overall[-1] >= 100.0              # MODELS.md §4.14
+    curves = rbr["rb08_fig03"].tables["curves"]
+    for c in curves.columns[1:]:
+        y = curves.column(c)
+        assert np.all(np.isfinite(y)) and np.all(y > 0), c
+    # the surface lobe peaks near the specular direction for oblique incidence
+    for row in rng.rows[:-1]:
+        ti, tmax = row[0], row[3]
+        if ti >= 40:
+            assert abs(tmax - ti) < 5.0, (ti, tmax)
+    params = dict(rbr["rb08_fig03"].tables["params"].rows)
+    assert len(params) == 14
+
+
+def test_rb08_figures_labelled(rbr):
+    for rep in rbr.values():
+        _check_axes(rep)
+    assert rbr["rb08_fig03"].figure.axes[0].get_yscale() == "log"

@@ -414,10 +414,15 @@ def plot_comparison(model: Model, measurement: Measurement, *, channel: int | st
             ax.plot(_deg(ts_grid), yc, color=col, lw=1.2, ls="-" if gi == 0 else "--",
                     label=rf"model $\theta_i$ = {math.degrees(t):.3g}°{pname}")
     vals = np.concatenate(all_vals) if all_vals else np.array([])
+    # the data set the value range (a model can diverge at grazing, e.g. unshadowed TR75)
     if _auto_log(vals):
         ax.set_yscale("log")
         pos = vals[np.isfinite(vals) & (vals > 0)]
         ax.set_ylim(pos.min() / 3, pos.max() * 3)
+    elif np.isfinite(vals).any():
+        fin = vals[np.isfinite(vals)]
+        lo, hi = min(0.0, float(fin.min())), float(fin.max())
+        ax.set_ylim(lo - 0.05 * (hi - lo), hi + 0.25 * (hi - lo) if hi > lo else hi + 1.0)
     ax.set_xlim(-90, 90)
     ax.set_xticks(np.arange(-90, 91, 30))
     ax.set_xlabel(SIGNED_LABEL)

@@ -418,7 +418,8 @@ def plot_comparison(model: Model, measurement: Measurement, *, channel: int | st
     if _auto_log(vals):
         ax.set_yscale("log")
         pos = vals[np.isfinite(vals) & (vals > 0)]
-        ax.set_ylim(pos.min() / 3, pos.max() * 3)
+        # the 0.5th percentile keeps a few noise values near zero from stretching the axis
+        ax.set_ylim(max(pos.min(), float(np.percentile(pos, 0.5))) / 3, pos.max() * 3)
     elif np.isfinite(vals).any():
         fin = vals[np.isfinite(vals)]
         lo, hi = min(0.0, float(fin.min())), float(fin.max())
@@ -449,7 +450,8 @@ def plot_residual_map(model: Model, measurement: Measurement, *, channel: int | 
 
     Each sample sits at ``(sin θr cos φ, sin θr sin φ)`` (forward side to the right), coloured
     by its residual on a diverging scale symmetric about 0 (clipped at the 98th percentile of
-    ``|residual|``); each incidence has its own marker. The r.m.s. relative residual (TR75's
+    ``|residual|``, and at ±1 at most: a factor 2 off is saturated); each incidence has its own
+    marker. The r.m.s. relative residual (TR75's
     σ, Eq. 34) is in the title.
     """
     fig, ax = new_axes(ax, figsize=(6.0, 4.8))
@@ -457,8 +459,9 @@ def plot_residual_map(model: Model, measurement: Measurement, *, channel: int | 
     x = np.sin(meas.theta_r) * np.cos(meas.phi)
     y = np.sin(meas.theta_r) * np.sin(meas.phi)
     ok = np.isfinite(res)
-    lim = float(np.percentile(np.abs(res[ok]), 98)) if ok.any() else 1.0
-    lim = lim if lim > 0 else 1.0
+    p98 = float(np.percentile(np.abs(res[ok]), 98)) if ok.any() else 1.0
+    lim = min(p98, 1.0) if p98 > 0 else 1.0
+    clipped = bool(ok.any() and np.abs(res[ok]).max() > lim)
     norm = mcolors.TwoSlopeNorm(vcenter=0.0, vmin=-lim, vmax=lim)
     markers = ["o", "s", "^", "D", "v", "P", "X", "*", "<", ">"]
     incs = meas.incidences(4)
@@ -472,7 +475,8 @@ def plot_residual_map(model: Model, measurement: Measurement, *, channel: int | 
                         linewidths=0.2, label=rf"$\theta_i$ = {math.degrees(t):.3g}°")
         ax.plot([math.sin(t)], [0.0], marker="+", color="k", ms=6, ls="none")
     if sc is not None:
-        fig.colorbar(sc, ax=ax, label="(data − model) / model", shrink=0.9)
+        fig.colorbar(sc, ax=ax, label="(data − model) / model", shrink=0.9,
+                     extend="both" if clipped else "neither")
     _disk_decorations(ax)
     rms = float(np.sqrt(np.mean(res[ok] ** 2))) if ok.any() else float("nan")
     ax.set_title(f"{model.name}: relative residual [{meas.channels[0]}], r.m.s. {rms:.3g}",

@@ -30,15 +30,21 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._jit import as_float_array, jit, ufunc
+from ._jit import as_float_array, ufunc
 
 __all__ = ["gammaincc", "gammaincc_q", "stirlerr", "bd0", "FINITE_SUM_MAX"]
 
 #: largest integer ``a`` for which the finite-sum fast path is used (cost ~a multiply-adds)
 FINITE_SUM_MAX = 64
+
+# The scalar parts are compiled as ordinary Numba functions, called (not inlined at the Numba IR
+# level) from the kernels that use them: their loops, inlined into a parallel model kernel several
+# times, made its first compilation take minutes; LLVM still inlines the small ones.
+jit = numba.njit(cache=True, error_model="numpy")
 
 _EPS = 1e-16  # relative size of a term/correction below which a series/CF has converged
 _FPMIN = 1e-300  # Lentz's guard against a zero denominator (far below any value reached)

@@ -4,9 +4,9 @@ Every distribution is stored as its *peak-normalized* shape ``P`` (``P(theta_h =
 form TR75 Fig. 5 compares) times a normalization constant ``K(param)`` (sr⁻¹), so that
 ``D = K P`` is the standard per-solid-angle facet-normal density of microfacet theory.
 
-==================  =======  =================================================  =====================
-name (aliases)      param    peak shape P(alpha)                                reference
-==================  =======  =================================================  =====================
+==================  =======  ================================================  ====================
+name (aliases)      param    peak shape P(alpha)                               reference
+==================  =======  ================================================  ====================
 trowbridge-reitz    e        e^4 / (e^2 cos^2 a + sin^2 a)^2                    TR75 Eq. 31; GGX a=e
 (ggx, tr, tr75)
 beckmann            m        cos^-4 a exp(-tan^2 a / m^2)                       Beckmann 1963
@@ -14,7 +14,7 @@ gaussian-angle      c        exp(-(c a_deg)^2), ``c`` per degree                
 (ts67, rense)
 berry               e        e^2 / (e^2 cos^2 a + sin^2 a)                      TR75 Fig. 5 (Berry)
 sirohi              A2       cos^-2 a exp(-A2 tan^2 a)                          TR75 Fig. 5 (Sirohi)
-==================  =======  =================================================  =====================
+==================  =======  ================================================  ====================
 
 Normalizations: Trowbridge-Reitz ``1/(pi e^2)``; Beckmann ``1/(pi m^2)``; Berry
 ``(e^2 - 1)/(pi e^2 ln e^2)`` (``1/pi`` at e = 1); gaussian-angle and Sirohi by adaptive
@@ -129,7 +129,7 @@ def check_param(code: int, value: float, name: str = "") -> None:
 # --------------------------------------------------------------------------------------------
 @jit
 def peak(code, c, a):
-    """Peak-normalized shape ``P`` at ``cos theta_h = c`` for distribution ``code``, parameter ``a``."""
+    """Peak-normalized shape ``P`` at ``cos theta_h = c`` for distribution ``code``, width ``a``."""
     c = min(1.0, max(0.0, c))
     s2 = 1.0 - c * c
     if code == TR:
@@ -180,7 +180,8 @@ def _peak(code, c, a):
 @functools.lru_cache(maxsize=4096)
 def _numeric_norm(code: int, a: float) -> float:
     def integrand(alpha: float) -> float:
-        return 2 * math.pi * float(_peak(code, math.cos(alpha), a)) * math.cos(alpha) * math.sin(alpha)
+        c = math.cos(alpha)
+        return 2 * math.pi * float(_peak(code, c, a)) * c * math.sin(alpha)
 
     width = 1.0 / (a * _DEG) if code == GAUSS_ANGLE else math.atan(1.0 / math.sqrt(a))
     pts = [p for p in (0.5 * width, width, 3 * width) if p < 0.5 * math.pi]
@@ -199,6 +200,18 @@ def normalization(code: int, a: float) -> float:
         ratio = 1.0 if abs(x) < 1e-12 else x / math.log1p(x)
         return ratio / (math.pi * a * a)
     return _numeric_norm(int(code), float(a))
+
+
+@jit(inline=True)
+def trowbridge_reitz_d(c, e):
+    """Scalar part: normalized Trowbridge-Reitz/GGX ``e^2/(pi (e^2 c^2 + 1 - c^2)^2)``.
+
+    The same value as ``evaluate_d(TR, c, e, 1/(pi e^2))``, as a small inlined part for the TR75
+    kernel (MODELS.md §3.7).
+    """
+    c = min(1.0, max(0.0, c))
+    q = e * e * c * c + (1.0 - c * c)
+    return e * e / (math.pi * q * q)
 
 
 @jit

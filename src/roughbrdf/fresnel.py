@@ -31,12 +31,13 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._jit import as_float_array, jit, ufunc
+from ._jit import as_float_array, jit, sincos, ufunc
 
-__all__ = ["fresnel_sp", "fresnel_polarized", "reflectance", "polarization_angle", "check_index"]
+__all__ = ["fresnel_sp", "fresnel_polarized", "fresnel_polarized_cs", "reflectance",
+           "polarization_angle", "check_index"]
 
 
-@jit
+@jit(inline=True)
 def fresnel_sp(c, n, k):
     """Scalar part: ``(R_s, R_p)`` at ``cos t = c`` for index ``n + i k`` (MODELS.md §1.4)."""
     s2 = 1.0 - c * c
@@ -44,28 +45,40 @@ def fresnel_sp(c, n, k):
     im = 2.0 * n * k  # Im (n + ik)^2
     zr = re - s2
     mod = math.sqrt(zr * zr + im * im)
-    # principal square root q = a + ib of z = zr + i im, computed without cancellation:
-    # take the large component from the sqrt and the other one as im / (2 * large).
-    if mod == 0.0:
-        a = 0.0
-        b = 0.0
-    elif zr >= 0.0:
-        a = math.sqrt(0.5 * (mod + zr))
-        b = 0.5 * im / a
-    else:
-        b = math.sqrt(0.5 * (mod - zr))
-        a = 0.5 * im / b
+    # principal square root q = a + ib of z = zr + i im, computed without cancellation: the
+    # larger component is t = sqrt((|z| + |zr|)/2), the other one im/(2 t). Written with
+    # selects (no branches) and guarded denominators, so that vectorized code, which evaluates
+    # both sides, never divides by zero (NumPy would report it as a warning in the ufuncs).
+    t = math.sqrt(0.5 * (mod + abs(zr)))
+    u = 0.5 * im / (t if t > 0.0 else 1.0)  # t = 0 only if z = 0, and then im = 0: u = 0
+    a = t if zr >= 0.0 else u
+    b = u if zr >= 0.0 else t
+    # den = 0 only for n + ik = 1 at exactly grazing incidence (z = 0, c = 0): index matched,
+    # no interface; the limit along c -> 0 is R = 0, which the guarded quotients give.
     den = (c + a) * (c + a) + b * b
-    if den == 0.0:
-        # only for n + ik = 1 at exactly grazing incidence (z = 0, c = 0): index matched, no
-        # interface; the limit along c -> 0 is R = 0.
-        return 0.0, 0.0
-    rs = ((c - a) * (c - a) + b * b) / den
+    rs = ((c - a) * (c - a) + b * b) / (den if den > 0.0 else 1.0)
     pr = re * c
     pi_ = im * c
     denp = (pr + a) * (pr + a) + (pi_ + b) * (pi_ + b)
-    rp = ((pr - a) * (pr - a) + (pi_ - b) * (pi_ - b)) / denp
+    rp = ((pr - a) * (pr - a) + (pi_ - b) * (pi_ - b)) / (denp if denp > 0.0 else 1.0)
     return rs, rp
+
+
+@jit(inline=True)
+def fresnel_polarized_cs(c, n, k, gamma, cos_eta, sin_eta):
+    """Scalar part of TR75 Eq. 24 with ``eta`` given as ``(cos eta, sin eta)``.
+
+    ``R = R_s sin^2(gamma - eta) + R_p cos^2(gamma - eta)``; ``gamma`` NaN -> ``(R_s + R_p)/2``.
+    Branch-free and without libm calls, so model loops that use it vectorize (the
+    ``(cos eta, sin eta)`` pair comes from :func:`roughbrdf.geometry.tr75_eta_cs`).
+    """
+    rs, rp = fresnel_sp(c, n, k)
+    unpolarized = gamma != gamma  # NaN encodes "unpolarized"
+    # no arithmetic on the NaN: it would raise NumPy's "invalid value" warning in ufuncs
+    sg, cg = sincos(0.0 if unpolarized else gamma)
+    sn = sg * cos_eta - cg * sin_eta  # sin(gamma - eta)
+    pol = rs * sn * sn + rp * (1.0 - sn * sn)
+    return 0.5 * (rs + rp) if unpolarized else pol
 
 
 @jit
@@ -74,11 +87,8 @@ def fresnel_polarized(c, n, k, gamma, eta):
 
     ``R = R_s sin^2(gamma - eta) + R_p cos^2(gamma - eta)``; ``gamma`` NaN -> ``(R_s + R_p)/2``.
     """
-    rs, rp = fresnel_sp(c, n, k)
-    if gamma != gamma:  # NaN encodes "unpolarized"
-        return 0.5 * (rs + rp)
-    sn = math.sin(gamma - eta)
-    return rs * sn * sn + rp * (1.0 - sn * sn)
+    se, ce = sincos(eta)
+    return fresnel_polarized_cs(c, n, k, gamma, ce, se)
 
 
 @ufunc(5)
@@ -116,7 +126,8 @@ def check_index(n: float, k: float) -> None:
     if not (math.isfinite(n) and n > 0):
         raise ValueError(f"refractive index n must be finite and > 0, got {n!r}")
     if not (math.isfinite(k) and k >= 0):
-        raise ValueError(f"extinction index k must be finite and >= 0 (n + ik, absorbing), got {k!r}")
+        raise ValueError(
+            f"extinction index k must be finite and >= 0 (n + ik, absorbing), got {k!r}")
 
 
 def reflectance(
@@ -160,9 +171,11 @@ def reflectance(
     na = as_float_array(n, "n")
     ka = as_float_array(k, "k")
     if np.any(~np.isfinite(na) | (na <= 0)):
-        raise ValueError(f"refractive index n must be finite and > 0, got {na[~(na > 0)].flat[0]!r}")
+        bad = na[~(np.isfinite(na) & (na > 0))].flat[0]
+        raise ValueError(f"refractive index n must be finite and > 0, got {bad!r}")
     if np.any(~np.isfinite(ka) | (ka < 0)):
-        raise ValueError(f"extinction index k must be finite and >= 0, got {ka[~(ka >= 0)].flat[0]!r}")
+        bad = ka[~(np.isfinite(ka) & (ka >= 0))].flat[0]
+        raise ValueError(f"extinction index k must be finite and >= 0, got {bad!r}")
     g = polarization_angle(polarization)
     return _reflectance(c, na, ka, g, as_float_array(eta, "eta"))
 

@@ -36,7 +36,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._jit import as_float_array, jit, ufunc
+from ._jit import SINCOS_MAX_ARG, as_float_array, jit, sincos, ufunc
 
 HALF_PI = 0.5 * math.pi
 
@@ -79,6 +79,11 @@ def check_zenith(x: ArrayLike, name: str, *, open_upper: bool = False) -> np.nda
         the message names ``name`` and the first offending value.
     """
     arr = as_float_array(x, name)
+    if arr.size:
+        # fast path: two passes without temporaries (min/max propagate NaN, so NaN fails here)
+        lo, hi = arr.min(), arr.max()
+        if lo >= 0.0 and (hi < HALF_PI if open_upper else hi <= HALF_PI):
+            return arr
     bad = ~np.isfinite(arr)
     if bad.any():
         raise ValueError(f"{name} must be finite, got {arr[bad].flat[0]!r}")
@@ -100,14 +105,18 @@ def check_angles(
     """Validate and convert a (theta_i, theta_r, phi) triple of the common frame.
 
     ``grazing_incidence=False`` rejects ``theta_i = pi/2`` for models that divide by
-    ``cos theta_i``. ``phi`` may be any finite angle (it is periodic).
+    ``cos theta_i``. ``phi`` may be any finite angle (it is periodic); azimuths beyond
+    ``roughbrdf._jit.SINCOS_MAX_ARG`` (8e5 rad) are reduced to [0, 2 pi) here, because the
+    kernels' sine/cosine are accurate only up to there.
     """
     ti = check_zenith(theta_i, "theta_i", open_upper=not grazing_incidence)
     tr = check_zenith(theta_r, "theta_r")
     ph = as_float_array(phi, "phi")
-    bad = ~np.isfinite(ph)
-    if bad.any():
-        raise ValueError(f"phi must be finite, got {ph[bad].flat[0]!r}")
+    if ph.size and not (ph.min() >= -SINCOS_MAX_ARG and ph.max() <= SINCOS_MAX_ARG):
+        bad = ~np.isfinite(ph)
+        if bad.any():
+            raise ValueError(f"phi must be finite, got {ph[bad].flat[0]!r}")
+        ph = np.mod(ph, 2.0 * math.pi)
     np.broadcast_shapes(ti.shape, tr.shape, ph.shape)  # raises a clear NumPy error if not
     return ti, tr, ph
 
@@ -115,31 +124,29 @@ def check_angles(
 # --------------------------------------------------------------------------------------------
 # scalar parts (compiled)
 # --------------------------------------------------------------------------------------------
-@jit
+@jit(inline=True)
 def half_vector(ti, tr, phi):
     """Half vector of the common frame, scalar part.
 
     Returns ``(hx, hy, hz, cos_d, cos_i, cos_r, sin_i)`` where ``h`` is the unit half vector
     (``hz = cos theta_h``) and ``cos_d = w_i . h = |w_i + w_r|/2``.
     """
-    si = math.sin(ti)
-    ci = math.cos(ti)
-    sr = math.sin(tr)
-    cr = math.cos(tr)
+    si, ci = sincos(ti)  # vectorizable sin/cos (see roughbrdf._jit.sincos)
+    sr, cr = sincos(tr)
+    sp, cp = sincos(phi)
     # cos(pi/2) is 6e-17, not 0; clip so that exact grazing gives exactly zero cosines.
-    if ci < 1e-15:
-        ci = 0.0
-    if cr < 1e-15:
-        cr = 0.0
-    sx = sr * math.cos(phi) - si
-    sy = sr * math.sin(phi)
+    ci = 0.0 if ci < 1e-15 else ci
+    cr = 0.0 if cr < 1e-15 else cr
+    sx = sr * cp - si
+    sy = sr * sp
     sz = ci + cr
     length = math.sqrt(sx * sx + sy * sy + sz * sz)
     if length == 0.0:
         # w_i = -w_r: both grazing and opposite (retro at theta = 90 deg). No facet can connect
         # them; return a horizontal "half vector" with cos_d = 0 so every model gives 0 there.
         return 1.0, 0.0, 0.0, 0.0, ci, cr, si
-    return sx / length, sy / length, sz / length, 0.5 * length, ci, cr, si
+    inv = 1.0 / (length if length > 0.0 else 1.0)  # guarded: vectorized code runs both sides
+    return sx * inv, sy * inv, sz * inv, 0.5 * length, ci, cr, si
 
 
 @jit
@@ -152,9 +159,10 @@ def ts67_projected(ti, tr, phi):
     whose arcsin branches are wrong for 19 % of geometries.
     """
     hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
-    sr = math.sin(tr)
-    wrx = sr * math.cos(phi)
-    wry = sr * math.sin(phi)
+    sr = sincos(tr)[0]
+    sp, cp = sincos(phi)
+    wrx = sr * cp
+    wry = sr * sp
     hxy = math.sqrt(hx * hx + hy * hy)
     if hxy > 1e-300:
         ux = hx / hxy
@@ -175,10 +183,25 @@ def ts67_projected(ti, tr, phi):
 def tr75_eta_from_h(si, ci, hx, hy, hz):
     """TR75 angle eta between the local and the macroscopic planes of incidence (Eq. 23).
 
-    ``sin eta sin s = h_y`` and ``cos eta sin s = (w_i x h)_y = sin(theta_i) h_z + cos(theta_i) h_x``
+    ``sin eta sin s = h_y`` and
+    ``cos eta sin s = (w_i x h)_y = sin(theta_i) h_z + cos(theta_i) h_x``
     (MODELS.md §3.5, recommended sign). At ``s = 0`` both vanish and eta = 0 (R_s = R_p there).
     """
     return math.atan2(hy, si * hz + ci * hx)
+
+
+@jit(inline=True)
+def tr75_eta_cs(si, ci, hx, hy, hz):
+    """``(cos eta, sin eta)`` of :func:`tr75_eta_from_h` without ``atan2`` (vectorizable).
+
+    ``(1, 0)`` at ``s = 0`` (the local plane of incidence is undefined; R_s = R_p there).
+    """
+    x = si * hz + ci * hx
+    length = math.sqrt(x * x + hy * hy)
+    inv = 1.0 / (length if length > 0.0 else 1.0)
+    if length > 0.0:
+        return x * inv, hy * inv
+    return 1.0, 0.0
 
 
 # --------------------------------------------------------------------------------------------

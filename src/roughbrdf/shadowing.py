@@ -103,7 +103,7 @@ def _safe_div(a, b):
     return a / b if b > 0.0 else math.inf
 
 
-@jit
+@jit(inline=True)
 def v_groove_g(ci, cr, ch, cd):
     """Scalar TS67 V-groove G from cosines (closed form, MODELS.md §2.5)."""
     if cd <= 0.0:
@@ -111,7 +111,7 @@ def v_groove_g(ci, cr, ch, cd):
     return min(1.0, 2.0 * ch * cr / cd, 2.0 * ch * ci / cd)
 
 
-@jit
+@jit(inline=True)
 def v_groove_g_over_cos_r(ci, cr, ch, cd):
     """Scalar ``G/cos(theta_r)`` per branch (TS67; finite at theta_r = 90 deg, MODELS.md §2.5).
 

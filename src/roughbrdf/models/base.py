@@ -66,7 +66,8 @@ class Parameter:
         except (TypeError, ValueError) as exc:
             raise ValueError(f"parameter {self.name!r} must be a number, got {value!r}") from exc
         lo, lo_inc, hi, hi_inc = self.domain
-        ok = math.isfinite(v) and (v >= lo if lo_inc else v > lo) and (v <= hi if hi_inc else v < hi)
+        ok = (math.isfinite(v) and (v >= lo if lo_inc else v > lo)
+              and (v <= hi if hi_inc else v < hi))
         if not ok:
             lo_s = ("[" if lo_inc else "(") + f"{lo:g}"
             hi_s = f"{hi:g}" + ("]" if hi_inc else ")")
@@ -114,7 +115,8 @@ def polarization_array(polarization: Any) -> np.ndarray:
         return np.vectorize(polarization_angle, otypes=[np.float64])(arr)
     arr = _jit.as_float_array(arr, "polarization")
     if np.isinf(arr).any():
-        raise ValueError(f"polarization angle gamma must be finite, got {arr[np.isinf(arr)].flat[0]!r}")
+        bad = arr[np.isinf(arr)].flat[0]
+        raise ValueError(f"polarization angle gamma must be finite, got {bad!r}")
     return arr  # NaN entries mean unpolarized
 
 
@@ -124,7 +126,7 @@ class Model:
     Subclasses define ``name``, ``short`` (prefix in sums), ``reference``, ``PARAMETERS`` (a tuple
     of :class:`Parameter` with default values), optional ``OPTIONS`` (non-numeric settings with
     defaults), ``grazing_incidence`` (whether theta_i = pi/2 is allowed), and ``_point`` and
-    ``_pack``.
+    ``_pack`` (and optionally ``_drive``, see :mod:`roughbrdf._jit`).
     """
 
     name: ClassVar[str] = ""
@@ -136,6 +138,9 @@ class Model:
     grazing_incidence: ClassVar[bool] = False
     reciprocal: ClassVar[bool] = True
     _point: ClassVar[Callable | None] = None
+    #: optional module-level parallel loop over ``_point`` (``roughbrdf._jit.driver``): the
+    #: vectorized, disk-cached fast path; without it the generic driver is used.
+    _drive: ClassVar[Callable | None] = None
 
     def __init__(self, **kwargs: Any) -> None:
         specs = {p.name: p for p in self._parameter_specs()}
@@ -213,7 +218,8 @@ class Model:
         """Evaluate on already validated float arrays (used by fitters)."""
         if term is not None:
             raise ValueError(f"model {self.name!r} has no separate terms; got term={term!r}")
-        return _jit.evaluate(type(self)._point, ti, tr, phi, gamma, self._pack(), flag)
+        cls = type(self)
+        return _jit.evaluate(cls._point, ti, tr, phi, gamma, self._pack(), flag, cls._drive)
 
     def _prepare(self, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
                  polarization: Any) -> tuple[np.ndarray, ...]:
@@ -259,7 +265,7 @@ class Model:
         return SumModel([*_components(self), *_components(other)])
 
     def to_dict(self) -> dict[str, Any]:
-        """``{"model": name, "params": {...}, "options": {...}}`` (round-trips via :func:`model`)."""
+        """``{"model": name, "params": {...}, "options": {...}}``; round-trips via :func:`model`."""
         return {"model": self.name, "params": self.params, "options": self.options}
 
     def describe(self) -> str:
@@ -281,7 +287,8 @@ def _components(m: Model) -> list[Model]:
 
 
 class SumModel(Model):
-    """Sum of models; parameter names are prefixed ``<short>_<name>`` (``<short><i>_`` if repeated)."""
+    """Sum of models; parameter names are prefixed ``<short>_<name>`` (``<short><i>_`` if repeated).
+    """
 
     name = "sum"
     short = "sum"

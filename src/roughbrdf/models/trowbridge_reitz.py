@@ -23,21 +23,23 @@ from __future__ import annotations
 
 import math
 
+from numba import prange
+
 from .. import distributions as dist
 from .. import shadowing as shd
-from .._jit import jit
-from ..fresnel import check_index, fresnel_polarized
-from ..geometry import half_vector, tr75_eta_from_h
+from .._jit import at, driver, jit
+from ..fresnel import check_index, fresnel_polarized_cs
+from ..geometry import half_vector, tr75_eta_cs
 from .base import Model, nonnegative, positive, register, unit_interval
 
 
-@jit
+@jit(inline=True)
 def _tr75_point(ti, tr, phi, gamma, p, flag):
     e, n, k, rho_l, shadow = p[0], p[1], p[2], p[3], p[4]
     hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
-    eta = 0.0 if gamma != gamma else tr75_eta_from_h(si, ci, hx, hy, hz)
-    r = fresnel_polarized(cd, n, k, gamma, eta)
-    spec = r * dist.evaluate_d(dist.TR, hz, e, 1.0 / (math.pi * e * e)) / (4.0 * ci)
+    ce, se = tr75_eta_cs(si, ci, hx, hy, hz)  # eta, TR75 Eq. 23 (MODELS.md §3.5)
+    r = fresnel_polarized_cs(cd, n, k, gamma, ce, se)
+    spec = r * dist.trowbridge_reitz_d(hz, e) / (4.0 * ci)
     if flag:  # BRIDF, Eq. 33
         if shadow > 0.0:
             spec *= shd.v_groove_g(ci, cr, hz, cd)
@@ -48,6 +50,12 @@ def _tr75_point(ti, tr, phi, gamma, p, flag):
     if cr <= 0.0:
         return math.inf  # unshadowed Eq. 30 over cos(theta_r) diverges at the horizon
     return spec / cr + rho_l / math.pi
+
+
+@driver
+def _tr75_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
+    for i in prange(out.size):
+        out[i] = _tr75_point(at(a, i), at(b, i), at(c, i), at(g, i), p, flag)
 
 
 @register
@@ -85,6 +93,7 @@ class TrowbridgeReitz1975(Model):
     )
     OPTIONS = {"shadowing": "none"}
     _point = _tr75_point
+    _drive = _tr75_drive
 
     def _check_options(self, options):
         code = shd.get(options["shadowing"])

@@ -29,10 +29,12 @@ but it is counted as a fitted parameter in the statistics, and its standard erro
 
 Global search and speed
 -----------------------
-Each channel is fitted on its own. ``starts`` starting points are used: the model's current
-values, then scrambled Sobol points in the bounds of the free parameters
-(:class:`scipy.stats.qmc.Sobol`), plus the best point of the previous channel when several channels
-are fitted (a warm start; every channel still gets all its own starts). When a channel has more
+Each channel is fitted on its own. ``starts`` local fits are run: one from the model's current
+values, the others from scrambled Sobol points in the bounds of the free parameters
+(:class:`scipy.stats.qmc.Sobol`): ``screen`` Sobol points are evaluated once each and the best
+ones, kept apart from each other, are used. When several channels are fitted, the best point of
+the previous channel is one more start (a warm start; every channel still gets all its own
+starts). When a channel has more
 than ``subsample`` samples, the local fits from the starts run on a fixed random subsample of that
 size, and the ``polish`` best distinct end points are then refined on all samples; the best of
 those is the result. The Jacobian is a forward finite difference computed through the compiled
@@ -79,7 +81,10 @@ _F_FLOOR = 1e-12
 # Residuals that are still not finite (a model that overflows at some trial parameters) are
 # replaced by this value, so that the optimizer sees a large, finite cost and steps back.
 _BAD_RESIDUAL = 1e6
-_EXPLORE_TOL = 1e-8
+# Tolerance of the local fits of the exploration stage: they only need to find the basin, the
+# polish on all samples converges tightly (1e-9).
+_EXPLORE_TOL = 1e-4
+_SCREEN_DIST = 0.15
 _X_SCALE = "jac"
 
 
@@ -604,6 +609,31 @@ def _model_label(m: Model) -> str:
     return "+".join(c.name for c in comps) if comps else m.name
 
 
+def _screen(obj: _Objective, cand: np.ndarray, k: int, lo: np.ndarray, hi: np.ndarray
+            ) -> list[np.ndarray]:
+    """The ``k`` best of the candidate points by cost (one model evaluation each), skipping
+    points closer than ``_SCREEN_DIST`` (in units of the bounds) to a better one already kept."""
+    if k <= 0 or cand.shape[0] == 0:
+        return []
+    if cand.shape[0] <= k:
+        return list(cand)
+    costs = np.array([float(np.sum(obj.fun(c) ** 2)) for c in cand])
+    order = np.argsort(costs, kind="stable")
+    u = (cand - lo) / (hi - lo)
+    kept: list[int] = []
+    for i in order:
+        if all(np.max(np.abs(u[i] - u[j])) >= _SCREEN_DIST for j in kept):
+            kept.append(int(i))
+        if len(kept) == k:
+            break
+    for i in order:  # too few far-apart points: fill up with the next best
+        if len(kept) == k:
+            break
+        if int(i) not in kept:
+            kept.append(int(i))
+    return [cand[i] for i in kept]
+
+
 def _sobol(d: int, n: int, seed: Any) -> np.ndarray:
     if n <= 0:
         return np.empty((0, d))
@@ -780,7 +810,8 @@ def fit(model: Model | str, measurement: Measurement, *,
         bounds: Mapping[str, Sequence[float]] | None = None, starts: int = 8,
         seed: int | None = 0, nonfinite: str = "raise", negative: str = "keep",
         relative_to: str | None = None, free_scale: bool | None = None,
-        subsample: int | None = 2000, polish: int = 2, max_nfev: int | None = None,
+        screen: int = 64, subsample: int | None = 1000, polish: int = 2,
+        max_nfev: int | None = None,
         progress: bool | None = None) -> FitResult:
     """Fit ``model`` to ``measurement``, each channel on its own.
 
@@ -804,8 +835,12 @@ def fit(model: Model | str, measurement: Measurement, *,
     bounds : dict, optional
         ``name -> (low, high)``, overriding the model's default search ranges.
     starts : int
-        Starting points per channel: the model's values, then Sobol points in the bounds
-        (``starts=1`` is a plain local fit from the model's values).
+        Local fits per channel: one from the model's values, then ``starts - 1`` from Sobol
+        points in the bounds (``starts=1`` is a plain local fit from the model's values).
+    screen : int
+        Number of Sobol points in the bounds whose cost is evaluated (one model evaluation
+        each) to choose the ``starts - 1`` starting points: the lowest-cost ones, kept at least
+        0.15 of the bounds apart.
     seed : int or None
         Seed of the scrambled Sobol sequence and of the subsample (results are reproducible).
     nonfinite : {"raise", "drop"}
@@ -871,7 +906,8 @@ def fit(model: Model | str, measurement: Measurement, *,
     if not chans:
         raise ValueError("no channel to fit")
     rng = np.random.default_rng(seed)
-    sobol = _sobol(len(free), starts - 1, seed)
+    n_screen = max(starts - 1, int(screen)) if starts > 1 else 0
+    sobol = _sobol(len(free), n_screen, seed)
     sobol_x = lo + sobol * (hi - lo)
 
     # prepare every channel first, so that bad input fails before any work
@@ -911,7 +947,8 @@ def fit(model: Model | str, measurement: Measurement, *,
                                      None if w is None else w[sub], flag, loss, free_scale)
             else:
                 explore = full
-            points = [x0] + ([warm] if warm is not None else []) + list(sobol_x)
+            points = [x0] + ([warm] if warm is not None else []) + _screen(
+                explore, sobol_x, starts - 1, lo, hi)
             kw = {"method": "trf", "x_scale": _X_SCALE, "max_nfev": max_nfev}
             tried: list[dict[str, Any]] = []
             ends: list[tuple[float, np.ndarray, Any]] = []

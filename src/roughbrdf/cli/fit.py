@@ -1,0 +1,140 @@
+"""``roughbrdf fit FILE --model NAME --out DIR``: fit a model to a measurement file.
+
+Writes ``fit.json`` (keys ``model``, ``file``, ``loss``, ``channels``: per channel ``channel``,
+``params``, ``stderr``, ``success``, ``metrics`` with ``sigma``, ``rms_log``, ``chi2``, ``aic``,
+``bic``, ``n_points``; more keys may follow), ``report.txt`` and one ``fit_<channel>.png`` per
+channel into DIR. DIR may exist: files roughbrdf wrote there before are replaced, any other file
+of the same name is left alone and the command stops (``--force`` overrides); see
+:mod:`roughbrdf._outdir`.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any
+
+import typer
+
+from .. import models as _models
+from .common import parse_params
+
+
+def build_model(spec: str, params: dict[str, Any] | None = None) -> _models.Model:
+    """A model from ``name`` or ``name1+name2`` and ``-p`` settings.
+
+    In a sum, a setting may use the prefixed parameter name (``tr75_e``, as ``roughbrdf models``
+    and the fit report show it) or a plain name or option that belongs to exactly one component
+    (``distribution=beckmann``).
+    """
+    params = dict(params or {})
+    names = [s.strip() for s in spec.split("+")]
+    if not all(names):
+        raise ValueError(f"bad model {spec!r}: expected NAME or NAME+NAME")
+    if len(names) == 1:
+        return _models.model(names[0], **params)
+    defaults = [_models.model(n) for n in names]
+    total = defaults[0]
+    for d in defaults[1:]:
+        total = total + d
+    per: list[dict[str, Any]] = [{} for _ in names]
+    for key, val in params.items():
+        hit = [i for i, pre in enumerate(total.prefixes)
+               if key.startswith(pre) and key[len(pre):] in defaults[i].params]
+        if hit:
+            i = hit[0]
+            per[i][key[len(total.prefixes[i]):]] = val
+            continue
+        hit = [i for i, d in enumerate(defaults) if key in d.params or key in d.options]
+        if len(hit) == 1:
+            per[hit[0]][key] = val
+        elif not hit:
+            raise ValueError(f"unknown parameter {key!r} for {spec}; parameters: "
+                             f"{', '.join(total.param_names)}")
+        else:
+            raise ValueError(f"{key!r} is ambiguous in {spec}; use one of "
+                             + ", ".join(total.prefixes[i] + key for i in hit))
+    comps = [_models.model(n, **kw) for n, kw in zip(names, per, strict=True)]
+    out = comps[0]
+    for c in comps[1:]:
+        out = out + c
+    return out
+
+
+def resolve_names(model: _models.Model, names: list[str]) -> list[str]:
+    """Map ``--fix`` names to the model's parameter names (plain names allowed in sums)."""
+    out = []
+    for nm in names:
+        if nm in model.param_names:
+            out.append(nm)
+            continue
+        hit = [p for p in model.param_names if "_" in p and p.split("_", 1)[1] == nm
+               and any(p == pre + nm for pre in getattr(model, "prefixes", []))]
+        if len(hit) == 1:
+            out.append(hit[0])
+        elif hit:
+            raise ValueError(f"{nm!r} is ambiguous; use one of {', '.join(hit)}")
+        else:
+            raise ValueError(f"unknown parameter {nm!r}; parameters: "
+                             f"{', '.join(model.param_names)}")
+    return out
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("fit")
+    def fit_cmd(
+        file: str = typer.Argument(..., help="measurement file (.astm, .dat/.alta, .csv, "
+                                             ".binary)"),
+        model: str = typer.Option(..., "--model", "-m",
+                                  help="model name or sum, e.g. trowbridge-reitz-1975 or "
+                                       "microfacet+lambertian"),
+        out: str = typer.Option(..., "--out", "-o", help="output folder"),
+        param: Annotated[list[str] | None, typer.Option(
+            "-p", "--param", help="starting value or option, name=value (repeatable)")] = None,
+        fix: Annotated[list[str] | None, typer.Option(
+            "--fix", help="keep this parameter at its value (repeatable)")] = None,
+        channel: Annotated[list[str] | None, typer.Option(
+            "--channel", "-c", help="channel label or index (repeatable; default: all)")] = None,
+        loss: str = typer.Option("relative", help="relative ((x-f)/f, TR75), log or absolute"),
+        starts: int = typer.Option(8, help="multistart points per channel"),
+        quantity: str = typer.Option(None, help="what the file's values are, if the file does "
+                                                "not say: brdf, brdf_cos, bridf or relative"),
+        relative_to: str = typer.Option(None, "--relative-to",
+                                        help="for relative data: brdf or bridf (default: the "
+                                             "file's relative_to, else brdf)"),
+        file_format: str = typer.Option(None, "--format", help="override the format chosen "
+                                                               "from the extension"),
+        nonfinite: str = typer.Option("raise", help="non-finite values: raise or drop"),
+        negative: str = typer.Option("keep", help="negative values: keep, drop or clip"),
+        seed: int = typer.Option(0, help="seed of the Sobol starts and the subsample"),
+        plots: bool = typer.Option(True, "--plots/--no-plots", help="write PNG plots"),
+        force: bool = typer.Option(False, "--force",
+                                   help="overwrite files of the same name not written by "
+                                        "roughbrdf"),
+        quiet: bool = typer.Option(False, "--quiet", "-q", help="no report on the terminal"),
+    ) -> None:
+        """Fit a model to a measurement file; write fit.json, report.txt and plots into --out."""
+        from .. import io as _io
+        from ..fitting import fit
+
+        try:
+            m = build_model(model, parse_params(param))
+            fixed = resolve_names(m, list(fix or []))
+            opts: dict[str, Any] = {}
+            if quantity:
+                opts["quantity"] = quantity
+            meas = _io.read(file, format=file_format, **opts)
+            # labels or positions as text; Measurement.channel_index resolves both ("525" also
+            # finds "525nm")
+            res = fit(m, meas, channel=list(channel) if channel else None, loss=loss, fix=fixed,
+                      starts=starts, seed=seed,
+                      nonfinite=nonfinite, negative=negative, relative_to=relative_to,
+                      progress=None if not quiet else False)
+            written = res.save(out, plots=plots, force=force)
+        except (ValueError, FileNotFoundError, FileExistsError, TypeError) as exc:
+            typer.echo(f"error: {exc}", err=True)
+            raise typer.Exit(2) from exc
+        if not quiet:
+            typer.echo(res.report())
+            typer.echo("")
+        typer.echo("wrote " + ", ".join(str(p) for p in written))
+        if not res.success:
+            raise typer.Exit(1)

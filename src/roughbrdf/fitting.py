@@ -96,11 +96,13 @@ class _Objective:
 
     def __init__(self, base: Model, free: list[str], lo: np.ndarray, hi: np.ndarray,
                  ti: np.ndarray, tr: np.ndarray, ph: np.ndarray, gamma: np.ndarray,
-                 x: np.ndarray, w: np.ndarray | None, flag: int, loss: str, free_scale: bool):
+                 x: np.ndarray, w: np.ndarray | None, flag: int, loss: str, free_scale: bool,
+                 fixed_scale: float = 1.0):
         self.base, self.free, self.lo, self.hi = base, free, lo, hi
         self.ti, self.tr, self.ph, self.flag = ti, tr, ph, flag
         self.gamma = gamma
         self.x, self.w, self.loss, self.free_scale = x, w, loss, free_scale
+        self.fixed_scale = fixed_scale
         self.w2 = None if w is None else w * w
         self.floor = _F_FLOOR * max(float(np.max(np.abs(x))), 1e-300)
         self.logx = np.log(x) if loss == "log" else None
@@ -125,7 +127,7 @@ class _Objective:
     def scale(self, f: np.ndarray) -> float:
         """Closed-form scale K of the data (``x -> K x``) for the model values ``f``."""
         if not self.free_scale:
-            return 1.0
+            return self.fixed_scale
         fs = np.maximum(f, self.floor)
         x = self.x
         if self.loss == "relative":
@@ -479,7 +481,7 @@ class FitResult:
         for c in self.channels:
             lines.append("")
             lines.append(f"[[Channel {c.channel}]]")
-            exc = ", ".join(f"{v} {k}" for k, v in c.excluded.items() if v) or "none"
+            exc = _excluded_text(c.excluded)
             nst = len([s for s in c.starts if s["stage"] != "full"])
             lines += [
                 f"    success            = {c.success}  ({c.message})",
@@ -515,6 +517,8 @@ class FitResult:
             if c.free_scale:
                 lines.append(f"    {'scale K':<{width}}: {_fmt(c.scale, 7)} +/- "
                              f"{_fmt(c.scale_stderr, 4)} (closed form)")
+            elif c.scale != 1.0:
+                lines.append(f"    {'scale K':<{width}}: {_fmt(c.scale, 7)} (given)")
             pairs = []
             names = list(c.correl)
             for i, a in enumerate(names):
@@ -714,6 +718,16 @@ def _channel_weights(weights: Any, meas: Measurement, j: int, x: np.ndarray, los
     return w
 
 
+_EXCLUDED_WORDS = {"nonfinite": "non-finite", "negative": "negative (dropped)",
+                   "clipped": "negative (clipped)", "zero_weight": "of zero weight",
+                   "model_domain": "where the model is not finite or not defined"}
+
+
+def _excluded_text(excluded: dict[str, int]) -> str:
+    return ", ".join(f"{v} {_EXCLUDED_WORDS.get(k, k)}" for k, v in excluded.items() if v) \
+        or "none"
+
+
 def _where(meas: Measurement, label: str) -> str:
     f = meas.meta.get("file")
     return f"{f}, channel {label!r}" if f else f"channel {label!r}"
@@ -776,7 +790,7 @@ def _prepare_channel(model: Model, meas: Measurement, j: int, flag: int, loss: s
     if idx.size == 0:
         total = int(x.size)
         raise ValueError(f"{_where(meas, label)}: no data to fit ({total} samples; left out: "
-                         + ", ".join(f"{v} {k}" for k, v in excluded.items() if v) + ")"
+                         + _excluded_text(excluded) + ")"
                          if total else f"{_where(meas, label)}: no data to fit (0 samples)")
     return idx, x[idx], (None if w is None else w[idx]), excluded
 
@@ -810,6 +824,7 @@ def fit(model: Model | str, measurement: Measurement, *,
         bounds: Mapping[str, Sequence[float]] | None = None, starts: int = 8,
         seed: int | None = 0, nonfinite: str = "raise", negative: str = "keep",
         relative_to: str | None = None, free_scale: bool | None = None,
+        scale: float | None = None,
         screen: int = 64, subsample: int | None = 1000, polish: int = 2,
         max_nfev: int | None = None,
         progress: bool | None = None) -> FitResult:
@@ -854,6 +869,11 @@ def fit(model: Model | str, measurement: Measurement, *,
         ``measurement.meta["relative_to"]`` if the reader found it, else ``"brdf"``.
     free_scale : bool, optional
         Fit a free scale ``K`` of the data in closed form. Default: only for ``relative`` data.
+        A model with an overall scale parameter of its own (TS67 ``rho_d``, microfacet ``ks``
+        alone) cannot tell it from ``K``: fix that parameter when fitting relative data.
+    scale : float, optional
+        A known data scale ``K`` (``x -> K x``) instead of a fitted one, e.g. for relative data
+        whose absolute calibration is known; the fit is then the absolute fit.
     subsample : int or None
         Above this many samples, the starts are explored on a fixed random subsample and the
         ``polish`` best end points refined on all samples. ``None`` uses all samples throughout.
@@ -894,6 +914,15 @@ def fit(model: Model | str, measurement: Measurement, *,
     polish = max(1, int(polish))
     meas = measurement
     flag, compared, rel = _resolve_quantity(meas, relative_to)
+    if scale is not None:
+        fixed_scale = float(scale)
+        if not (math.isfinite(fixed_scale) and fixed_scale > 0):
+            raise ValueError(f"scale must be finite and > 0, got {scale!r}")
+        if free_scale:
+            raise ValueError("give either scale= (a known data scale) or free_scale=True")
+        free_scale = False
+    else:
+        fixed_scale = 1.0
     if free_scale is None:
         free_scale = meas.quantity == "relative"
     free, lo, hi, x0 = _free_parameters(model, fix, bounds)
@@ -939,12 +968,14 @@ def fit(model: Model | str, measurement: Measurement, *,
                    else np.ascontiguousarray(meas.polarization[idx]))
             geo = (np.ascontiguousarray(meas.theta_i[idx]), np.ascontiguousarray(meas.theta_r[idx]),
                    np.ascontiguousarray(meas.phi[idx]))
-            full = _Objective(model, free, lo, hi, *geo, gam, x, w, flag, loss, free_scale)
+            full = _Objective(model, free, lo, hi, *geo, gam, x, w, flag, loss, free_scale,
+                              fixed_scale)
             if subsample is not None and idx.size > subsample:
                 sub = np.sort(rng.choice(idx.size, size=int(subsample), replace=False))
                 explore = _Objective(model, free, lo, hi, *(g[sub] for g in geo),
                                      gam if gam.ndim == 0 else gam[sub], x[sub],
-                                     None if w is None else w[sub], flag, loss, free_scale)
+                                     None if w is None else w[sub], flag, loss, free_scale,
+                                     fixed_scale)
             else:
                 explore = full
             points = [x0] + ([warm] if warm is not None else []) + _screen(
@@ -993,6 +1024,7 @@ def fit(model: Model | str, measurement: Measurement, *,
                      options={"starts": starts, "seed": seed, "subsample": subsample,
                               "polish": polish, "nonfinite": nonfinite, "negative": negative,
                               "free_scale": bool(free_scale),
+                              "scale": scale,
                               "fix": sorted(set(model.param_names) - set(free)),
                               "weights": None if weights is None else
                               (weights if isinstance(weights, str) else "array")},

@@ -58,10 +58,13 @@ class OutputDir:
         """Path for ``name`` inside the folder; checks it and records it as ours."""
         self.check([name])
         self.path.mkdir(parents=True, exist_ok=True)
-        if name not in self.owned:
-            self.owned.add(name)
+        # merge with the record on disk: another OutputDir on the same folder may have added to it
+        known = set(self._read_manifest())
+        if name not in known:
+            self.owned |= known | {name}
             (self.path / MANIFEST).write_text(json.dumps(sorted(self.owned), indent=1) + "\n",
                                               encoding="utf-8")
+        self.owned |= known
         return self.path / name
 
     def write_text(self, name: str, text: str) -> Path:

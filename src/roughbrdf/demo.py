@@ -61,7 +61,7 @@ def default_measurement_path() -> Path:
 def ts67_fig8_table() -> str:
     """TS67 Fig. 8 forward-peak table, computed vs MODELS.md §2.7."""
     ts = rb.model("torrance-sparrow-1967", g=2 / 3, c=0.05, n=None, k=None)
-    theta = np.radians(np.arange(0.0, 89.99, 0.05))
+    theta = np.radians(np.append(np.arange(0.0, 89.99, 0.05), 89.99))
     lines = ["TS67 Fig. 8: relative reflectance, Eq. 23 (F = 1, g = 2/3, c = 0.05/deg), "
              "plane of incidence",
              "  computed (this library) | MODELS.md §2.7",
@@ -76,10 +76,11 @@ def ts67_fig8_table() -> str:
         r89 = float(ts.relative(p, math.radians(89.99), 0.0))
         rm60 = float(ts.relative(p, math.radians(60.0), math.pi))
         tmax = math.degrees(theta[i])
-        tmax_s = "-> 90" if tmax > 89.9 else f"{tmax:.1f}"
+        tmax_s = "->90" if tmax > 89.9 else f"{tmax:.1f}"
         lines.append(f"  {psi:>4} {tmax_s:>9} {r[i]:>7.3f} {r0:>6.3f} {r89:>8.3f} {rm60:>6.3f} | "
                      f"{ref[0]:>9.1f} {ref[1]:>7.3f} {ref[2]:>6.3f} {ref[3]:>8.3f} {ref[4]:>6.3f}")
-    lines.append("  (psi = 75: the ratio keeps rising to grazing; max over theta < 89.99 deg)")
+    lines.append("  (psi = 75: the ratio keeps rising to grazing; max over theta <= 89.99 deg; "
+                 "MODELS.md rounds it to 3.19)")
     return "\n".join(lines)
 
 

@@ -1,0 +1,128 @@
+"""``roughbrdf fit FILE --model NAME --out DIR``: outputs, model sums, options and errors."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import roughbrdf as rb
+from roughbrdf.cli import app
+from roughbrdf.cli.fit import build_model, resolve_names
+from roughbrdf.demo import default_measurement_path
+
+runner = CliRunner()
+DEFAULT = default_measurement_path()
+
+
+def _fit(*args):
+    return runner.invoke(app, ["fit", *map(str, args)])
+
+
+def test_fit_writes_json_report_and_plots(tmp_path):
+    out = tmp_path / "out"
+    res = _fit(DEFAULT, "--model", "trowbridge-reitz-1975", "--starts", "2", "--out", out)
+    assert res.exit_code == 0, res.output
+    assert "[[Fit]] trowbridge-reitz-1975" in res.output and "TR75 sigma" in res.output
+    d = json.loads((out / "fit.json").read_text())
+    assert d["model"] == "trowbridge-reitz-1975" and d["loss"] == "relative"
+    assert d["file"].endswith("tr75_cement.csv")
+    (ch,) = d["channels"]
+    assert ch["channel"] == "relative" and ch["success"] is True
+    assert set(ch["params"]) == {"e", "n", "k", "rho_L"} == set(ch["stderr"])
+    m = ch["metrics"]
+    assert {"sigma", "rms_log", "chi2", "aic", "bic", "n_points"} <= set(m)
+    assert m["n_points"] == 432 and 0.08 < m["sigma"] < 0.12
+    assert ch["params"]["e"] == pytest.approx(0.68, abs=0.05)
+    assert (out / "report.txt").read_text().startswith("[[Fit]]")
+    assert (out / "fit_relative.png").stat().st_size > 10_000
+
+
+def test_sum_model_with_parameters_fix_and_loss(tmp_path):
+    out = tmp_path / "sum"
+    res = _fit(DEFAULT, "-m", "trowbridge-reitz-1975+lambertian", "-p", "tr75_rho_L=0",
+               "--fix", "rho_L", "-p", "rho=0.2", "--loss", "log", "--starts", "2", "--out",
+               out, "--no-plots", "-q")
+    assert res.exit_code == 0, res.output
+    assert "[[Fit]]" not in res.output  # --quiet
+    d = json.loads((out / "fit.json").read_text())
+    assert d["model"] == "trowbridge-reitz-1975+lambertian" and d["loss"] == "log"
+    ch = d["channels"][0]
+    assert ch["params"]["tr75_rho_L"] == 0.0 and ch["stderr"]["tr75_rho_L"] is None
+    assert ch["params"]["lambertian_rho"] == pytest.approx(0.33, abs=0.1)
+    assert not list(out.glob("*.png"))
+
+
+def test_build_model_and_names():
+    m = build_model("microfacet+lambertian", {"distribution": "beckmann", "rho": 0.2,
+                                               "microfacet_alpha": 0.4})
+    assert m.components[0].options["distribution"] == "beckmann"
+    assert m.params["lambertian_rho"] == 0.2 and m.params["microfacet_alpha"] == 0.4
+    assert resolve_names(m, ["alpha", "lambertian_rho"]) == ["microfacet_alpha",
+                                                              "lambertian_rho"]
+    with pytest.raises(ValueError, match="ambiguous.*tr75_n, microfacet_n"):
+        build_model("trowbridge-reitz-1975+microfacet", {"n": 1.5})
+    with pytest.raises(ValueError, match="unknown parameter 'bogus'"):
+        build_model("trowbridge-reitz-1975+lambertian", {"bogus": 1.0})
+    with pytest.raises(ValueError, match="unknown parameter 'bogus'"):
+        resolve_names(m, ["bogus"])
+    with pytest.raises(ValueError, match="expected NAME or NAME\\+NAME"):
+        build_model("lambertian+", {})
+
+
+def test_channel_quantity_and_alta_without_param_out(tmp_path):
+    """An ALTA file without #PARAM_OUT needs --quantity; --channel picks one channel."""
+    t_i, t_r, p = np.meshgrid(np.radians([15, 45]), np.radians(np.arange(0, 80, 5)),
+                              np.radians([0, 60, 120, 180]), indexing="ij")
+    t_i, t_r, p = t_i.ravel(), t_r.ravel(), p.ravel()
+    m = rb.model("trowbridge-reitz-1975", e=0.3, n=1.5, k=0.0, rho_L=0.1)
+    f = m.bridf(t_i, t_r, p)
+    # ALTA ISOTROPIC_TL_TV_PROJ_DPHI: x1 = theta_v cos(dphi), dphi = 0 on the source side
+    dphi = np.pi - p
+    rows = [f"{a:.9g} {b * math.cos(c):.9g} {b * math.sin(c):.9g} {v:.9g}"
+            for a, b, c, v in zip(t_i, t_r, dphi, f, strict=True)]
+    path = tmp_path / "noparam.dat"
+    path.write_text("#DIM 3 1\n#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI\n" + "\n".join(rows) + "\n")
+    res = _fit(path, "-m", "tr75", "--out", tmp_path / "a", "--starts", "2")
+    assert res.exit_code == 2 and "--quantity" in res.output
+    res = _fit(path, "-m", "tr75", "--quantity", "brdf_cos", "--channel", "0",
+               "--out", tmp_path / "a", "--starts", "2", "-q")
+    assert res.exit_code == 0, res.output
+    d = json.loads((tmp_path / "a" / "fit.json").read_text())
+    assert d["quantity"] == "brdf_cos" and d["channels"][0]["params"]["e"] == pytest.approx(
+        0.3, rel=1e-4)
+
+
+def test_errors_are_clear(tmp_path):
+    res = _fit(DEFAULT, "-m", "tr75", "--loss", "squared", "--out", tmp_path / "x")
+    assert res.exit_code == 2 and "unknown loss 'squared'" in res.output
+    res = _fit(tmp_path / "missing.astm", "-m", "tr75", "--out", tmp_path / "x")
+    assert res.exit_code == 2 and "no such file" in res.output
+    res = _fit(DEFAULT, "-m", "no-such-model", "--out", tmp_path / "x")
+    assert res.exit_code == 2 and "unknown model 'no-such-model'" in res.output
+    res = _fit(DEFAULT, "-m", "tr75", "--fix", "e", "--fix", "n", "--fix", "k", "--fix",
+               "rho_L", "--out", tmp_path / "x")
+    assert res.exit_code == 2 and "every parameter" in res.output
+    res = _fit(DEFAULT, "-m", "tr75", "--channel", "green", "--out", tmp_path / "x")
+    assert res.exit_code == 2 and "unknown channel 'green'" in res.output
+    assert not (tmp_path / "x").exists()
+
+
+def test_never_overwrites_foreign_files(tmp_path):
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "fit.json").write_text("{}")
+    (out / "notes.txt").write_text("keep")
+    args = (DEFAULT, "-m", "tr75", "--starts", "1", "--no-plots", "-q", "--out", out)
+    res = _fit(*args)
+    assert res.exit_code == 2 and "not overwriting fit.json" in res.output
+    assert (out / "fit.json").read_text() == "{}"
+    res = _fit(*args, "--force")
+    assert res.exit_code == 0, res.output
+    res = _fit(*args)  # now the files are ours: a second run replaces them
+    assert res.exit_code == 0, res.output
+    assert (out / "notes.txt").read_text() == "keep"
+    assert json.loads((out / "fit.json").read_text())["model"] == "trowbridge-reitz-1975"

@@ -126,6 +126,26 @@ def v_groove_g_over_cos_r(ci, cr, ch, cd):
     return min(1.0 / cr, masking, masking * ci / cr)
 
 
+@jit(inline=True)
+def v_groove_g_over_cos_cos(ci, cr, ch, cd):
+    """Scalar TS67 ``G/(cos theta_i cos theta_r)`` per branch (microfacet and absolute forms).
+
+    G is symmetric in (i, r), so ``G/cos`` of the *smaller* cosine is a per-branch quotient
+    that stays finite (:func:`v_groove_g_over_cos_r` with the arguments in either order), and
+    only the larger cosine is divided by. Finite unless both directions are exactly grazing,
+    where the limit is ``inf`` (0 if nothing reflects, ``cd = 0``).
+    """
+    if ci >= cr:
+        g_c = v_groove_g_over_cos_r(ci, cr, ch, cd)  # G / cos(theta_r)
+        big = ci
+    else:
+        g_c = v_groove_g_over_cos_r(cr, ci, ch, cd)  # G / cos(theta_i), by symmetry
+        big = cr
+    if big > 0.0:
+        return g_c / big
+    return math.inf if g_c > 0.0 else 0.0
+
+
 @jit
 def g21(psi_p, theta_p):
     """TS67 Eq. 21 in the cancellation-free form ``G = 1 - A/(1 + sqrt(1 - A^2))``."""
@@ -183,10 +203,7 @@ def g_over_cos_cos(code, dcode, a, ci, cr, ch, cd):
         den = ci * cr
         return 1.0 / den if den > 0.0 else math.inf  # the no-shadowing form diverges: limit inf
     if code == V_GROOVE:
-        if ci <= 0.0:
-            # G <= 2 ch ci/cd -> G/ci <= 2 ch/cd: the shadowing candidate stays finite
-            return _safe_div(2.0 * ch, cd * cr) if cd > 0.0 else 0.0
-        return v_groove_g_over_cos_r(ci, cr, ch, cd) / ci
+        return v_groove_g_over_cos_cos(ci, cr, ch, cd)
     return smith_g_over_cos_cos(code, dcode, a, ci, cr)
 
 
@@ -291,29 +308,25 @@ def rb08_v(chi, scale, a, st):
     return _special.gammaincc_q(a, scale * chi * chi, st)
 
 
-@jit
+@jit(inline=True)
 def rb08_e0(zeta0, gamma, delta):
     """Scalar ``E0 = exp(-gamma zeta0 exp(-delta zeta0^2))``, the incidence weight of Eq. 13."""
-    return math.exp(-gamma * zeta0 * math.exp(-delta * zeta0 * zeta0))
+    return _special.vexp(-gamma * zeta0 * _special.vexp(-delta * zeta0 * zeta0))
 
 
-@jit
+@jit(inline=True)
 def rb08_vm(zeta, e0, alpha2, w_a, w_b):
     """Scalar RB08 masking/shadowing multiplier Vm (Eq. 13) given ``E0`` (:func:`rb08_e0`).
 
     ``B = exp(-w_a zeta exp(-w_b alpha^2))``; Eq. 13 with ``Sgn`` is, piecewise,
     ``zeta < 0: B``; ``zeta > 0: 1 - E0 (1 - B)``; ``zeta = 0 (Sgn 0 = 0): (1 - E0 + B + B E0)/2``
-    (= 1, since B = 1 there: Vm is continuous).
+    (= 1, since B = 1 there: Vm is continuous). Branch-free (selects, vectorizable exp).
     """
-    if w_a == 0.0:
-        return 1.0  # B = 1 exactly, and every branch of Eq. 13 is then 1
-    u = -w_a * zeta * math.exp(-w_b * alpha2)  # log B
-    if zeta < 0.0:
-        return math.exp(u)
-    if zeta > 0.0:
-        return 1.0 + e0 * math.expm1(u)  # 1 - E0 (1 - B) without cancellation when B ~ 1
-    b = math.exp(u)
-    return 0.5 * (1.0 - e0 + b + b * e0)  # the literal Sgn(0) = 0 value of Eq. 13
+    b = _special.vexp(-w_a * zeta * _special.vexp(-w_b * alpha2))
+    pos = 1.0 + e0 * (b - 1.0)  # 1 - E0 (1 - B); within an ulp of Vm even when B ~ 1
+    zero = 0.5 * (1.0 - e0 + b + b * e0)  # the literal Sgn(0) = 0 value of Eq. 13
+    vm = b if zeta < 0.0 else (pos if zeta > 0.0 else zero)
+    return 1.0 if w_a == 0.0 else vm  # w_a = 0: B = 1 exactly and every branch of Eq. 13 is 1
 
 
 @ufunc(3)

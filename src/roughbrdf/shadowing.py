@@ -126,26 +126,6 @@ def v_groove_g_over_cos_r(ci, cr, ch, cd):
     return min(1.0 / cr, masking, masking * ci / cr)
 
 
-@jit(inline=True)
-def v_groove_g_over_cos_cos(ci, cr, ch, cd):
-    """Scalar TS67 ``G/(cos theta_i cos theta_r)`` per branch (microfacet and absolute forms).
-
-    G is symmetric in (i, r), so ``G/cos`` of the *smaller* cosine is a per-branch quotient
-    that stays finite (:func:`v_groove_g_over_cos_r` with the arguments in either order), and
-    only the larger cosine is divided by. Finite unless both directions are exactly grazing,
-    where the limit is ``inf`` (0 if nothing reflects, ``cd = 0``).
-    """
-    if ci >= cr:
-        g_c = v_groove_g_over_cos_r(ci, cr, ch, cd)  # G / cos(theta_r)
-        big = ci
-    else:
-        g_c = v_groove_g_over_cos_r(cr, ci, ch, cd)  # G / cos(theta_i), by symmetry
-        big = cr
-    if big > 0.0:
-        return g_c / big
-    return math.inf if g_c > 0.0 else 0.0
-
-
 @jit
 def g21(psi_p, theta_p):
     """TS67 Eq. 21 in the cancellation-free form ``G = 1 - A/(1 + sqrt(1 - A^2))``."""
@@ -203,7 +183,10 @@ def g_over_cos_cos(code, dcode, a, ci, cr, ch, cd):
         den = ci * cr
         return 1.0 / den if den > 0.0 else math.inf  # the no-shadowing form diverges: limit inf
     if code == V_GROOVE:
-        return v_groove_g_over_cos_cos(ci, cr, ch, cd)
+        if ci <= 0.0:
+            # G <= 2 ch ci/cd -> G/ci <= 2 ch/cd: the shadowing candidate stays finite
+            return _safe_div(2.0 * ch, cd * cr) if cd > 0.0 else 0.0
+        return v_groove_g_over_cos_r(ci, cr, ch, cd) / ci
     return smith_g_over_cos_cos(code, dcode, a, ci, cr)
 
 

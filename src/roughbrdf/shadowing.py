@@ -307,8 +307,8 @@ def rb08_vm(zeta, e0, alpha2, w_a, w_b):
     """
     b = _special.vexp(-w_a * zeta * _special.vexp(-w_b * alpha2))
     pos = 1.0 + e0 * (b - 1.0)  # 1 - E0 (1 - B); within an ulp of Vm even when B ~ 1
-    zero = 0.5 * (1.0 - e0 + b + b * e0)  # the literal Sgn(0) = 0 value of Eq. 13
-    vm = b if zeta < 0.0 else (pos if zeta > 0.0 else zero)
+    # zeta = 0: B = exp(0) = 1, and the literal Sgn(0) = 0 value (1 - E0 + B + B E0)/2 is 1
+    vm = b if zeta < 0.0 else (pos if zeta > 0.0 else 1.0)
     return 1.0 if w_a == 0.0 else vm  # w_a = 0: B = 1 exactly and every branch of Eq. 13 is 1
 
 

@@ -366,8 +366,9 @@ def gammaincc_int(a, x):
     """``Q(a, x) = e^-x Σ_{k<a} x^k/k!`` for integer-valued ``a`` in [1, INT_HORNER_MAX + 1].
 
     Branch-free: a fixed-length Horner loop whose coefficients ``1/k!`` are masked to 0 for
-    ``k >= a`` (LLVM unrolls it; all terms positive, no cancellation). ``x > 745`` (Q below
-    ~1e-290 for these a) gives 0.
+    ``k >= a`` (LLVM unrolls it; all terms positive, no cancellation): ~1e-14 relative. In
+    the far tail ``x > 708``, ``e^-x`` is subnormal and values below ~1e-290 lose digits;
+    ``x > 745`` gives 0. (RB08 only multiplies a width by V: such values act as 0 anyway.)
     """
     s = 0.0
     for j in range(INT_HORNER_MAX + 1):

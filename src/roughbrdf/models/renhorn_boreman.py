@@ -202,28 +202,24 @@ def _rb08_point(ti, tr, phi, gamma, p, flag):
 
 
 @driver
-def _rb08_fast(a, b, c, g, ns, nr, p, flag, out):  # pragma: no cover - compiled
-    # Vectorized loop (integer n, n_r <= INT_HORNER_MAX): everything per sample; with a scalar
-    # theta_i, LLVM hoists the incidence quantities out of the loop. ns/nr: numeric N per
-    # sample (NaN: the analytic N). No conditional expression in this body: with at() inlined,
-    # Numba's parfor pass would report an "overwrite of parallel loop index" (_or_nan selects).
+def _rb08_fast(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
+    # Vectorized loop (integer n, n_r <= INT_HORNER_MAX, analytic N): everything per sample;
+    # with a scalar theta_i, LLVM hoists the incidence quantities out of the loop.
     for k in prange(out.size):
         ti = at(a, k)
         si, ci, rs0, rp0, v0, v0r, e0, ns0, nr0 = _incidence(ti, p, True, False)
-        out[k] = _scatter(si, ci, rs0, rp0, v0, v0r, e0, _or_nan(at(ns, k), ns0),
-                          _or_nan(at(nr, k), nr0), ti, at(b, k), at(c, k), at(g, k), p,
-                          flag, True, False)
+        out[k] = _scatter(si, ci, rs0, rp0, v0, v0r, e0, ns0, nr0, ti, at(b, k), at(c, k),
+                          at(g, k), p, flag, True, False)
 
 
 @driver
-def _rb08_fast_lean(a, b, c, g, ns, nr, p, flag, out):  # pragma: no cover - compiled
+def _rb08_fast_lean(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
     # _rb08_fast for w_a = 0 and (w_r, n_r) = (w, n) (the defaults): no Vm, one shadowing pair
     for k in prange(out.size):
         ti = at(a, k)
         si, ci, rs0, rp0, v0, v0r, e0, ns0, nr0 = _incidence(ti, p, True, True)
-        out[k] = _scatter(si, ci, rs0, rp0, v0, v0r, e0, _or_nan(at(ns, k), ns0),
-                          _or_nan(at(nr, k), nr0), ti, at(b, k), at(c, k), at(g, k), p,
-                          flag, True, True)
+        out[k] = _scatter(si, ci, rs0, rp0, v0, v0r, e0, ns0, nr0, ti, at(b, k), at(c, k),
+                          at(g, k), p, flag, True, True)
 
 
 _CHUNK = 1024  # samples per task of the general loop (its incidence cache lives per task)
@@ -234,7 +230,8 @@ def _rb08_general(a, sa, b, sb, c, sc, g, sg, ns, sns, nr, snr, p, flag, out):  
     # Any real n: the incomplete gamma has loops, so this loop is not vectorized; instead the
     # incidence quantities (two or four Q evaluations) are recomputed only when theta_i changes
     # within a chunk (a fit's data, a grid with theta_i outermost, a scalar theta_i). Inputs
-    # of size 1 are broadcast with a zero stride (sa = 0).
+    # of size 1 are broadcast with a zero stride (sa = 0). ns/nr: numeric N per sample (NaN:
+    # the analytic N).
     n = out.size
     nchunks = (n + _CHUNK - 1) // _CHUNK
     for k in prange(nchunks):
@@ -252,21 +249,33 @@ def _rb08_general(a, sa, b, sb, c, sc, g, sg, ns, sns, nr, snr, p, flag, out):  
                               p, flag, False, False)
 
 
+def _dense_array(x: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    # a contiguous 1-D array of the broadcast shape (size 1 for a scalar shape)
+    if x.shape == shape and x.flags.c_contiguous:
+        return x.reshape(-1)
+    return np.ascontiguousarray(np.broadcast_to(x, shape)).reshape(-1)
+
+
 def _run(ti, tr, phi, gamma, p: tuple, flag: int, ns=None, nr=None):
-    """Broadcast the inputs and run the fast or the general driver (``ns``/``nr``: numeric N)."""
+    """Broadcast the inputs and run the fast or the general driver (``ns``/``nr``: numeric N).
+
+    The fast (vectorized) drivers take integer n, n_r, one polarization for all samples and the
+    analytic N; ``theta_i`` is passed as a float when it is one value (LLVM then hoists every
+    incidence quantity out of the loop), ``theta_s`` and ``phi`` always as arrays, which keeps
+    the number of compiled variants (each ~5 s the first time, then cached on disk) at four.
+    Everything else (real n, per-sample polarization, numeric N) runs the general driver.
+    """
     shape = np.broadcast_shapes(ti.shape, tr.shape, phi.shape, gamma.shape)
     n = math.prod(shape)
     out = np.empty(n, dtype=np.float64)
     if n:
         pt = tuple(float(v) for v in p)
-        if p[_FAST] == 1.0:
-            dense = _jit._dense
-            nsa = math.nan if ns is None else dense(ns, shape)
-            nra = math.nan if nr is None else dense(nr, shape)
+        if p[_FAST] == 1.0 and gamma.size == 1 and ns is None and nr is None:
             lean = p[_WA] == 0.0 and p[_SAME_V] == 1.0
             drive = _rb08_fast_lean if lean else _rb08_fast
-            drive(dense(ti, shape), dense(tr, shape), dense(phi, shape), dense(gamma, shape),
-                  nsa, nra, pt, int(flag), out)
+            a = float(ti.reshape(-1)[0]) if ti.size == 1 else _dense_array(ti, shape)
+            drive(a, _dense_array(tr, shape), _dense_array(phi, shape),
+                  float(gamma.reshape(-1)[0]), pt, int(flag), out)
         else:
             flat = _jit._flat
             nan = np.full(1, math.nan)

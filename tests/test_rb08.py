@@ -1,0 +1,659 @@
+"""Renhorn & Boreman (2008), RB08: the MODELS.md §4.14 targets and the model's contract.
+
+The reference numbers come from MODELS.md §4 (computed there by an independent NumPy/SciPy
+implementation). ``ref_terms`` below is a second, plain NumPy/SciPy transcription of the
+MODELS.md §4/§8 formulas as printed (literal N of Eq. 6, literal Eq. 13 with Sgn, Eqs. 16-17 in
+complex arithmetic, ``scipy.special.gammaincc``); the compiled kernel is checked against it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import integrate, special
+
+import roughbrdf as rb
+from roughbrdf import special as rbs
+from roughbrdf.fresnel import fresnel_sp
+from roughbrdf.models import renhorn_boreman as rbm
+
+deg = np.radians
+HALF_PI = math.pi / 2
+P_NAMES = ["rho", "w", "n", "w_a", "w_b", "gamma", "delta", "n_eff", "k_eff", "bulk", "retro",
+           "rho_r", "w_r", "n_r"]
+# a parameter set that switches every part on (Vm, real n, separate retro shadowing)
+FULL = dict(rho=0.25, w=0.7, n=3.5, w_a=0.4, w_b=1.5, gamma=0.8, delta=0.6, n_eff=1.6,
+            k_eff=0.3, bulk=0.6, retro=0.15, rho_r=0.15, w_r=0.8, n_r=2.0)
+
+
+def random_geometry(n, seed=0, ti_max=1.55):
+    rng = np.random.default_rng(seed)
+    return (rng.uniform(0, ti_max, n), rng.uniform(0, HALF_PI, n),
+            rng.uniform(-math.pi, math.pi, n))
+
+
+# ------------------------------------------------------------------------------------------
+# independent NumPy/SciPy reference (MODELS.md §4, §8)
+# ------------------------------------------------------------------------------------------
+def fresnel_eq16_17(alpha, n_eff, k_eff):
+    """RB08 Eqs. 16-17 written literally (complex arithmetic): (R_s, R_p) at sine alpha."""
+    nt = complex(n_eff, k_eff)
+    alpha = np.asarray(alpha, dtype=complex)
+    c = np.sqrt(1 - alpha**2)
+    t = np.sqrt(1 - alpha**2 / nt**2)
+    r_s = np.abs((c - nt * t) / (c + nt * t)) ** 2
+    r_p = np.abs((-nt * c + t) / (nt * c + t)) ** 2
+    return r_s, r_p
+
+
+def n_literal(a0, rho):
+    """Eq. 6 as printed (MODELS.md §4.5)."""
+    return 1.0 / (math.pi * np.log((1 - a0**2 + rho**2 + np.sqrt(
+        rho**4 + 2 * a0**2 * rho**2 + 2 * rho**2 + (1 - a0**2) ** 2)) / (2 * rho**2)))
+
+
+def vm_literal(zeta, zeta0, alpha, w_a, w_b, gamma, delta):
+    """Eq. 13 as printed, with Sgn, recommended signs (MODELS.md §4.8)."""
+    e0 = np.exp(-gamma * zeta0 * np.exp(-delta * zeta0**2))
+    b = np.exp(-w_a * zeta * np.exp(-w_b * alpha**2))
+    sg = np.sign(zeta)
+    return 0.5 * (1 - e0) * (sg + 1) + b * (0.5 * (1 - sg) + 0.5 * e0 * (sg + 1))
+
+
+def ref_terms(ti, ts, phi, p, zeta="angle", weight="geometric-mean", norm="literal",
+              pol="unpolarized"):
+    """(surface, bulk, retro, parts) of RB08 by MODELS.md §8 (``parts``: sigma_s, D, N, Vm...)."""
+    a0, ci = np.sin(ti), np.cos(ti)
+    s, cs = np.sin(ts), np.cos(ts)
+    a, b = s * np.cos(phi), s * np.sin(phi)
+
+    def refl(x):
+        r_s, r_p = fresnel_eq16_17(x, p["n_eff"], p["k_eff"])
+        return {"unpolarized": 0.5 * (r_s + r_p), "s": r_s, "p": r_p}[pol]
+
+    r0, rs = refl(a0), refl(s)
+    if weight == "geometric-mean":
+        sig = np.sqrt(r0 * rs)
+    elif weight == "product":
+        sig = r0 * rs
+    else:
+        sig = 1 - (1 - r0) * (1 - rs)
+
+    def v(chi, w, n):
+        return special.gammaincc(1 + n, (1 + n) * chi**2 / w**2)
+
+    h2 = 0.25 * (ci + cs) ** 2
+    d = (a - a0) ** 2 + b**2 + h2 * v(a0, p["w"], p["n"]) * v(s, p["w"], p["n"]) * p["rho"] ** 2
+    d_r = ((a + a0) ** 2 + b**2
+           + h2 * v(a0, p["w_r"], p["n_r"]) * v(s, p["w_r"], p["n_r"]) * p["rho_r"] ** 2)
+    if norm == "literal":
+        n_s, n_r = n_literal(a0, p["rho"]), n_literal(a0, p["rho_r"])
+    else:  # specular-width
+        n_s = n_literal(a0, p["rho"] * ci * v(a0, p["w"], p["n"]))
+        n_r = n_literal(a0, p["rho_r"] * ci * v(a0, p["w_r"], p["n_r"]))
+    if zeta == "angle":
+        z, z0, al = np.arcsin(a), ti, a
+    elif zeta == "cosine":
+        z, z0, al = a, a0, a
+    else:
+        z, z0, al = ts - ti, ti, s
+    vm = vm_literal(z, z0, al, p["w_a"], p["w_b"], p["gamma"], p["delta"])
+    surf = sig * n_s * vm / d
+    bulk = (1 - sig) * p["bulk"] / math.pi
+    retro = (1 - sig) * p["retro"] * n_r / d_r
+    return surf, bulk, retro, {"sigma": sig, "d": d, "d_r": d_r, "n_s": n_s, "n_r": n_r,
+                               "vm": vm}
+
+
+# ------------------------------------------------------------------------------------------
+# §4.5: N normalizes the basic lobe over the unit disk
+# ------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("a0", [0.0, 0.3, 0.7, 0.95])
+@pytest.mark.parametrize("rho", [0.05, 0.2, 0.6])
+def test_eq6_normalizes_basic_lobe(a0, rho):
+    # ∫∫_disk N/((alpha - a0)^2 + beta^2 + rho^2): polar coordinates about the peak, the radial
+    # integral in closed form, the azimuthal one by adaptive quadrature
+    def radial(psi):
+        c = math.cos(psi)
+        rmax = -a0 * c + math.sqrt(1 - a0 * a0 * math.sin(psi) ** 2)
+        return 0.5 * math.log1p(rmax * rmax / (rho * rho))
+
+    disk, _ = integrate.quad(radial, 0.0, 2 * math.pi, epsabs=1e-13, epsrel=1e-13, limit=200)
+    n = rbm.rb08_norm(1 - a0 * a0, a0 * a0, rho)
+    assert n * disk == pytest.approx(1.0, abs=1e-8)
+    assert n == pytest.approx(n_literal(a0, rho), rel=1e-13)  # stable form = printed form
+    if a0 == 0.0:  # MODELS.md §4.5: 1/(pi ln((1 + rho^2)/rho^2))
+        assert n == pytest.approx(1 / (math.pi * math.log((1 + rho**2) / rho**2)), rel=1e-14)
+
+
+def test_norm_stable_for_wide_and_narrow_lobes():
+    for rho in (1e-6, 1e-3, 10.0, 1e3):
+        for a0 in (0.0, 0.5, 0.999):
+            got = rbm.rb08_norm(1 - a0 * a0, a0 * a0, rho)
+            # N = 1/(pi log(arg)), evaluated here in extended care with log1p of arg - 1
+            ci2, r2 = 1 - a0 * a0, rho * rho
+            arg_m1 = (ci2 - r2 + math.sqrt((ci2 + r2) ** 2 + 4 * a0 * a0 * r2)) / (2 * r2)
+            if rho < 1:
+                expect = 1 / (math.pi * math.log1p(arg_m1))
+                assert got == pytest.approx(expect, rel=1e-12)
+            assert math.isfinite(got) and got > 0
+    assert rbm.rb08_norm(0.75, 0.25, 0.0) == 0.0  # rho -> 0: the log diverges
+
+
+# ------------------------------------------------------------------------------------------
+# §4.7: V = Q(1+n, (1+n) chi^2/w^2), the incomplete gamma inside the kernel
+# ------------------------------------------------------------------------------------------
+def test_v_identities():
+    chi = np.linspace(0, 1, 101)
+    for w in (0.2, 0.8, 1.5):
+        for n in (0.0, 0.5, 4.0, 37.3):
+            assert rb.shadowing.V(0.0, w, n) == 1.0  # V(0) = 1
+            v = rb.shadowing.V(chi, w, n)
+            assert np.all(np.diff(v) <= 0)  # decreasing in chi
+        # Eq. 11 (to the rounding of the argument, x = chi^2/w^2 <= 25: a few ulp)
+        np.testing.assert_allclose(rb.shadowing.V(chi, w, 0.0), np.exp(-chi**2 / w**2),
+                                   rtol=1e-14)
+
+
+def test_v_step_limit_for_large_n():
+    # MODELS.md §4.7, computed: n = 500, w = 0.8 gives 1, 1, 1, 1, 0.494, 0.000
+    got = rb.shadowing.V([0, 0.2, 0.4, 0.6, 0.8, 1.0], 0.8, 500)
+    np.testing.assert_allclose(got, [1, 1, 1, 1, 0.494, 0.000], atol=5e-4)
+    # V(w) -> 1/2: the median of a gamma variable is a - 1/3 + ..., so
+    # V(w) = Q(a, a) = 1/2 - 1/(3 sqrt(2 pi a)) + O(1/a)
+    prev = 1.0
+    for n in (5, 50, 500, 5000, 50000):
+        dev = abs(float(rb.shadowing.V(0.8, 0.8, n)) - 0.5)
+        assert dev == pytest.approx(1 / (3 * math.sqrt(2 * math.pi * (1 + n))), rel=0.2)
+        assert dev < prev
+        prev = dev
+    # step: far from w the values go to 1 and 0
+    assert rb.shadowing.V(0.7, 0.8, 50000) == pytest.approx(1.0, abs=1e-12)
+    assert rb.shadowing.V(0.9, 0.8, 50000) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_incomplete_gamma_against_scipy():
+    rng = np.random.default_rng(7)
+    avals = [1.0, 1.5, 2.0, 3.7, 5.0, 14.9, 15.0, 15.5, 30.0, 64.0, 65.0, 100.0, 250.3, 501.0,
+             777.7, 1000.0]
+    for a in avals:
+        x = np.abs(np.concatenate([np.linspace(0, 3 * a + 40, 1500),
+                                   a + math.sqrt(a) * rng.normal(0, 3, 1500),
+                                   [1e-300, 1e-12, 1e-3, a - 1, a, a + 1]]))
+        ref = special.gammaincc(a, x)
+        got = rbs.gammaincc(a, x)
+        ok = ref > 1e-30  # deeper in the tail the problem's own conditioning (|x - a| ulps)
+        rtol = 1e-12 if a <= 500 else 2e-12  # dominates both implementations
+        np.testing.assert_allclose(got[ok], ref[ok], rtol=rtol, atol=0)
+        assert np.all(got[~ok] < 1e-29)
+    assert rbs.gammaincc(3.0, np.inf) == 0.0
+    with pytest.raises(ValueError, match="a must"):
+        rbs.gammaincc(0.0, 1.0)
+    with pytest.raises(ValueError, match="x must"):
+        rbs.gammaincc(1.0, -1.0)
+
+
+def test_integer_horner_path_against_scipy():
+    x = np.linspace(0, 120, 3001)
+    for n in range(rbs.INT_HORNER_MAX + 1):
+        a = n + 1.0
+        got = np.array([rbs.gammaincc_int(a, xx) for xx in x])
+        np.testing.assert_allclose(got, special.gammaincc(a, x), rtol=5e-14)
+        # deep tail (Q ~ 1e-280): the conditioning |x - a| ulp of the problem itself; beyond
+        # x = 708 e^-x is subnormal (documented: Q < ~1e-290 loses digits, 0 beyond x = 745)
+        assert rbs.gammaincc_int(a, 700.0) == pytest.approx(special.gammaincc(a, 700.0),
+                                                             rel=1e-12)
+        assert rbs.gammaincc_int(a, 746.0) == 0.0
+
+
+@pytest.mark.parametrize("fn, ref, lo, hi, ulps", [
+    (rbs.vexp, np.exp, -745.0, 709.0, 1),
+    (rbs.vlog, np.log, 1e-300, 1e300, 1),
+    (rbs.vlog1p, np.log1p, 0.0, 1e30, 2),
+    (rbs.vasin, np.arcsin, -1.0, 1.0, 2),
+])
+def test_vectorizable_elementary_functions(fn, ref, lo, hi, ulps):
+    rng = np.random.default_rng(3)
+    if fn is rbs.vlog or fn is rbs.vlog1p:
+        x = np.exp(rng.uniform(math.log(max(lo, 1e-300)), math.log(hi), 20000))
+        x = np.concatenate([x, rng.uniform(0, 2, 5000)])
+    else:
+        x = np.concatenate([rng.uniform(lo, hi, 20000), rng.uniform(-1, 1, 5000) * min(hi, 1)])
+    got = np.array([fn(v) for v in x])
+    want = ref(x)
+    nz = want != 0
+    err = np.abs(got[nz] - want[nz]) / np.spacing(np.abs(want[nz]))
+    assert err.max() <= ulps
+    # special values
+    assert rbs.vexp(-1000.0) == 0.0 and rbs.vexp(1000.0) == math.inf
+    assert math.isnan(rbs.vexp(math.nan)) and rbs.vexp(0.0) == 1.0
+    assert rbs.vlog(0.0) == -math.inf and math.isnan(rbs.vlog(-1.0))
+    assert rbs.vlog(5e-324) == pytest.approx(math.log(5e-324), rel=1e-15)
+    assert rbs.vlog1p(0.0) == 0.0 and rbs.vlog1p(1e-300) == 1e-300
+    assert rbs.vlog1p(math.inf) == math.inf
+    assert rbs.vasin(1.0) == pytest.approx(HALF_PI, rel=1e-16) and math.isnan(rbs.vasin(1.5))
+
+
+# ------------------------------------------------------------------------------------------
+# §4.8: Vm, piecewise identities and continuity
+# ------------------------------------------------------------------------------------------
+def test_vm_piecewise_identities_and_continuity():
+    rng = np.random.default_rng(11)
+    for _ in range(50):
+        w_a, w_b, delta = rng.uniform(-3, 3, 3)
+        gamma = rng.uniform(0, 3)
+        zeta0 = rng.uniform(0, HALF_PI)
+        z = rng.uniform(-HALF_PI, HALF_PI, 200)
+        al = np.sin(z)
+        got = rb.shadowing.Vm(z, zeta0, w_a, w_b, gamma, delta)
+        e0 = math.exp(-gamma * zeta0 * math.exp(-delta * zeta0**2))
+        b = np.exp(-w_a * z * np.exp(-w_b * al**2))
+        expect = np.where(z < 0, b, 1 - e0 * (1 - b))  # MODELS.md §4.8 piecewise form
+        np.testing.assert_allclose(got, expect, rtol=1e-14)
+        np.testing.assert_allclose(got, vm_literal(z, zeta0, al, w_a, w_b, gamma, delta),
+                                   rtol=1e-14)  # = Eq. 13 as printed
+        assert 0 < e0 <= 1 and np.all(got > 0)
+        # Vm(0) = 1 (Sgn 0 = 0) and continuity across zeta = 0
+        assert rb.shadowing.Vm(0.0, zeta0, w_a, w_b, gamma, delta) == 1.0
+        for eps in (1e-6, 1e-9, 1e-12):
+            for side in (-eps, eps):
+                v = rb.shadowing.Vm(side, zeta0, w_a, w_b, gamma, delta)
+                assert v == pytest.approx(1.0, abs=10 * abs(w_a) * eps + 1e-15)
+    # alpha given explicitly (the direction-cosine reading)
+    assert rb.shadowing.Vm(0.3, 0.2, 1.0, 2.0, 0.5, 0.1, alpha=0.3) == pytest.approx(
+        vm_literal(0.3, 0.2, 0.3, 1.0, 2.0, 0.5, 0.1), rel=1e-15)
+    with pytest.raises(ValueError, match="zeta0"):
+        rb.shadowing.Vm(0.1, math.nan, 1, 1, 1, 1)
+    for kwargs, name in [((0.5, -1.0, 1.0), "w"), ((0.5, 0.8, -1.0), "n"),
+                         ((math.inf, 0.8, 1.0), "chi")]:
+        with pytest.raises(ValueError, match=name):
+            rb.shadowing.V(*kwargs)
+
+
+# ------------------------------------------------------------------------------------------
+# §4.9: Eqs. 16-17 are the core Fresnel
+# ------------------------------------------------------------------------------------------
+def test_eq16_17_equal_core_fresnel():
+    alpha = np.linspace(0, 1, 201)
+    worst = 0.0
+    for n_eff in (0.2, 0.7, 1.0, 1.33, 1.5, 2.4, 5.0):
+        for k_eff in (0.0, 0.01, 0.5, 3.0, 10.0):
+            with np.errstate(invalid="ignore"):  # 0/0 of the literal form at alpha = 1, n = 1
+                r_s, r_p = fresnel_eq16_17(alpha, n_eff, k_eff)
+            if n_eff == 1.0 and k_eff == 0.0:  # index matched: R = 0 (the limit)
+                r_s, r_p = np.nan_to_num(r_s), np.nan_to_num(r_p)
+            core = np.array([fresnel_sp(math.sqrt(1 - x * x), n_eff, k_eff) for x in alpha])
+            worst = max(worst, np.abs(core[:, 0] - r_s).max(), np.abs(core[:, 1] - r_p).max())
+            r0 = abs((complex(n_eff, k_eff) - 1) / (complex(n_eff, k_eff) + 1)) ** 2
+            assert r_s[0] == pytest.approx(r0, abs=1e-15) and r_p[0] == pytest.approx(r0,
+                                                                                      abs=1e-15)
+    assert worst < 1e-14
+
+
+# ------------------------------------------------------------------------------------------
+# the kernel against the independent reference, every option
+# ------------------------------------------------------------------------------------------
+OPTION_SETS = [
+    {},
+    {"zeta": "cosine", "surface_weight": "product"},
+    {"zeta": "zenith-difference", "surface_weight": "transmission", "polarization": "s"},
+    {"normalization": "specular-width", "polarization": "p"},
+]
+
+
+@pytest.mark.parametrize("opts", OPTION_SETS, ids=lambda o: ",".join(o.values()) or "defaults")
+@pytest.mark.parametrize("params", [{}, FULL, dict(FULL, n=4.0, n_r=4.0, w_r=0.7)],
+                         ids=["defaults", "full", "full-integer-n"])
+def test_kernel_matches_reference(opts, params):
+    m = rb.model("rb08", **opts, **params)
+    ti, ts, ph = random_geometry(3000, seed=5)
+    surf, bulk, retro, _ = ref_terms(ti, ts, ph, m.params, **{
+        "zeta": m.options["zeta"], "weight": m.options["surface_weight"],
+        "norm": m.options["normalization"], "pol": m.options["polarization"]})
+    np.testing.assert_allclose(m.brdf(ti, ts, ph, term="surface"), surf, rtol=1e-11)
+    # bulk and retro carry 1 - sigma_s, small where R -> 1 (s polarization near grazing);
+    # there the literal Eqs. 16-17 of the reference, written with the sine alpha (cos = sqrt(1 -
+    # alpha^2)), lose digits: hence the absolute tolerance
+    np.testing.assert_allclose(m.brdf(ti, ts, ph, term="bulk"), bulk, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(m.brdf(ti, ts, ph, term="retro"), retro, rtol=1e-11,
+                               atol=1e-12)
+    np.testing.assert_allclose(m.brdf(ti, ts, ph), surf + bulk + retro, rtol=1e-11, atol=1e-12)
+    np.testing.assert_allclose(m.bridf(ti, ts, ph), (surf + bulk + retro) * np.cos(ts),
+                               rtol=1e-11, atol=1e-12)
+
+
+def test_fast_and_general_kernels_agree():
+    # integer n runs the vectorized kernel; forcing the general one (series/continued
+    # fraction, per-chunk incidence cache) must give the same numbers
+    ti, ts, ph = random_geometry(5000, seed=9)
+    for params in ({}, dict(FULL, n=4.0, n_r=2.0), dict(FULL, n=0.0, n_r=16.0)):
+        m = rb.model("rb08", **params)
+        p = list(m._pack())
+        assert p[rbm._FAST] == 1.0
+        fast = m.brdf(ti, ts, ph)
+        p[rbm._FAST] = 0.0
+        general = rbm._run(ti, ts, ph, np.full(1, np.nan), tuple(p), 0)
+        np.testing.assert_allclose(fast, general, rtol=1e-13)
+        # scalar theta_i (incidence hoisted out of the loop) = the same numbers
+        np.testing.assert_allclose(m.brdf(0.7, ts, ph), m.brdf(np.full(5000, 0.7), ts, ph),
+                                   rtol=1e-15)
+    assert rb.model("rb08", n=4.5)._pack()[rbm._FAST] == 0.0
+    assert rb.model("rb08", n_r=17.0)._pack()[rbm._FAST] == 0.0
+
+
+# ------------------------------------------------------------------------------------------
+# §4.10 energy split: sigma_bulk/bulk = sigma_retro/retro = 1 - sigma_surface
+# ------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("weight", ["geometric-mean", "product", "transmission"])
+@pytest.mark.parametrize("pol", ["unpolarized", "s", "p"])
+def test_energy_split_identity(weight, pol):
+    m = rb.model("rb08", surface_weight=weight, polarization=pol, **FULL)
+    ti, ts, ph = random_geometry(2000, seed=2)
+    ti = np.concatenate([ti, [0.0, 0.5, 0.5, 1.2, 0.0]])
+    ts = np.concatenate([ts, [0.0, 0.5, 0.5, HALF_PI, HALF_PI]])
+    ph = np.concatenate([ph, [0.0, 0.0, math.pi, 1.0, 2.0]])
+    surf, bulk, retro = (m.brdf(ti, ts, ph, term=t) for t in ("surface", "bulk", "retro"))
+    _, _, _, parts = ref_terms(ti, ts, ph, m.params, weight=weight, pol=pol)
+    sigma_surface = surf * parts["d"] / (parts["n_s"] * parts["vm"])
+    sigma_bulk = bulk * math.pi
+    sigma_retro = retro * parts["d_r"] / parts["n_r"]
+    np.testing.assert_allclose(sigma_bulk / FULL["bulk"], 1 - sigma_surface, rtol=1e-11)
+    np.testing.assert_allclose(sigma_retro / FULL["retro"], 1 - sigma_surface, rtol=1e-11)
+    np.testing.assert_allclose(sigma_surface, parts["sigma"], rtol=1e-11)
+    if weight == "geometric-mean":  # at the specular point sigma_s = R(theta_i)
+        r_s, r_p = fresnel_eq16_17(math.sin(0.5), FULL["n_eff"], FULL["k_eff"])
+        r = {"unpolarized": 0.5 * (r_s + r_p), "s": r_s, "p": r_p}[pol]
+        assert sigma_surface[-4] == pytest.approx(float(r), rel=1e-12)
+
+
+# ------------------------------------------------------------------------------------------
+# §4.12 normalization table: ∫ BRDF cos(theta_s) dΩ of the surface lobe with sigma = 1
+# ------------------------------------------------------------------------------------------
+def unit_sigma(rho, normalization):
+    # sigma_surface = 1: a perfect conductor (R = 1 - 4e-16 at every angle), no bulk or retro
+    # term, Vm = 1 (w_a = 0); w = 0.9, n = 4 as in MODELS.md §4.12
+    return rb.model("rb08", rho=rho, w=0.9, n=4, w_a=0.0, n_eff=1.0, k_eff=1e8, bulk=0.0,
+                    retro=0.0, normalization=normalization)
+
+
+TABLE_412 = {  # theta_i -> (rho 0.1 literal, rho 0.1 effective, rho 0.3 literal, 0.3 effective)
+    0: (1.005, 1.005, 1.043, 1.043),
+    30: (1.083, 1.008, 1.189, 1.053),
+    60: (1.778, 0.999, 2.271, 0.989),
+    75: (2.595, 0.998, 3.275, 0.978),
+}
+
+
+def test_section_412_normalization_table():
+    th = deg(sorted(TABLE_412))
+    want = np.array([TABLE_412[k] for k in sorted(TABLE_412)])
+    assert unit_sigma(0.1, "literal").brdf(0.3, 0.3, 0.0, term="bulk") == 0.0
+    got = np.column_stack([
+        rb.albedo(unit_sigma(0.1, "literal"), th),
+        rb.albedo(unit_sigma(0.1, "specular-width"), th),
+        rb.albedo(unit_sigma(0.3, "literal"), th),
+        rb.albedo(unit_sigma(0.3, "specular-width"), th),
+    ])
+    np.testing.assert_allclose(got, want, atol=0.01)
+
+
+@pytest.mark.parametrize("rho", [0.05, 0.3, 1.0])
+def test_numeric_normalization_integrates_to_sigma(rho):
+    th = deg([0.0, 30.0, 60.0, 75.0, 85.0])
+    got = rb.albedo(unit_sigma(rho, "numeric"), th, n_psi=384, n_panels=32)
+    np.testing.assert_allclose(got, 1.0, atol=2e-4)
+
+
+def test_lobe_integral_quadrature_converged():
+    th = deg([0.0, 20.0, 45.0, 70.0, 85.0, 89.0])
+    for rho, w, n in [(0.3, 0.9, 4.0), (0.02, 0.6, 0.0), (1.5, 1.2, 7.5), (1.0, 0.8, 500.0)]:
+        fine = rbm.lobe_integral(th, rho, w, n, n_psi=64, n_u=96, order=12)
+        got = rbm.lobe_integral(th, rho, w, n)
+        np.testing.assert_allclose(got[:-1], fine[:-1], rtol=1e-9)
+        assert got[-1] == pytest.approx(fine[-1], rel=1e-6)
+
+
+def test_numeric_table_path_matches_exact():
+    m = rb.model("rb08", normalization="numeric", rho=0.2, retro=0.1, rho_r=0.3, n_r=2)
+    ti = np.linspace(0, deg(89.9), 600)  # > 256 distinct incidences: the interpolated table
+    ts, ph = np.full(600, 0.4), np.full(600, 2.0)
+    table = m.brdf(ti, ts, ph)
+    exact = np.array([m.brdf(t, 0.4, 2.0) for t in ti[::37]])  # one incidence: exact
+    np.testing.assert_allclose(table[::37], exact, rtol=5e-7)
+
+
+# ------------------------------------------------------------------------------------------
+# Hypothesis: non-negativity and phi -> -phi symmetry over parameters and options
+# ------------------------------------------------------------------------------------------
+def _param_strategy():
+    specs = {p.name: p for p in rb.model("rb08").parameters}
+    return st.fixed_dictionaries({
+        nm: st.floats(max(specs[nm].bounds[0], 1e-3) if specs[nm].domain[0] == 0.0
+                      and not specs[nm].domain[1] else specs[nm].bounds[0],
+                      specs[nm].bounds[1], allow_nan=False)
+        for nm in P_NAMES})
+
+
+OPTIONS = st.fixed_dictionaries({
+    "zeta": st.sampled_from(["angle", "cosine", "zenith-difference"]),
+    "surface_weight": st.sampled_from(["geometric-mean", "product", "transmission"]),
+    "normalization": st.sampled_from(["literal", "specular-width"]),
+    "polarization": st.sampled_from(["unpolarized", "s", "p"]),
+})
+
+
+@settings(max_examples=60, deadline=None)
+@given(params=_param_strategy(), opts=OPTIONS, seed=st.integers(0, 2**31),
+       integer_n=st.booleans())
+def test_hypothesis_non_negative_and_phi_symmetric(params, opts, seed, integer_n):
+    if integer_n:  # exercise the vectorized kernel as well as the general one
+        params = dict(params, n=float(round(params["n"] % 17)),
+                      n_r=float(round(params["n_r"] % 17)))
+    m = rb.model("rb08", **params, **opts)
+    ti, ts, ph = random_geometry(64, seed=seed % 1000)
+    ti[:4] = [0.0, 1.5, 0.7, np.nextafter(HALF_PI, 0)]
+    ts[:4] = [0.0, 1.5, 0.7, HALF_PI]
+    f = m.brdf(ti, ts, ph)
+    assert not np.isnan(f).any()
+    assert (f >= 0).all()
+    np.testing.assert_allclose(m.brdf(ti, ts, -ph), f, rtol=1e-12, atol=0)
+    for t in ("surface", "bulk", "retro"):
+        assert (m.brdf(ti, ts, ph, term=t) >= 0).all()
+
+
+# ------------------------------------------------------------------------------------------
+# reciprocity: the model is not reciprocal (§4.13), and says so
+# ------------------------------------------------------------------------------------------
+def test_not_reciprocal():
+    m = rb.model("rb08")
+    assert m.reciprocal is False
+    # N(alpha0, rho) depends on the incidence only: swapping theta_i and theta_s changes the
+    # value even in the plane of incidence, with Vm = 1 (w_a = 0) and sigma symmetric (q = 1/2)
+    err = rb.reciprocity_error(m, deg([10.0, 20.0, 60.0]), deg([60.0, 70.0, 10.0]), 0.0)
+    assert np.all(err > 0.02)  # the (symmetric) bulk term dominates at the defaults
+    # the denominator and sigma_s are symmetric: with Vm = 1 the surface ratio is the ratio of
+    # the N's; Vm (w_a != 0) distinguishes incidence from scattering on top of that
+    ti, ts = deg(25.0), deg(55.0)
+    n = rbm.rb08_norm
+    ratio = n(math.cos(ti) ** 2, math.sin(ti) ** 2, 0.3) / n(math.cos(ts) ** 2,
+                                                            math.sin(ts) ** 2, 0.3)
+    m2 = rb.model("rb08", w_a=0.5, gamma=1.0)
+    for model, vm_on in ((m, False), (m2, True)):
+        a = model.brdf(ti, ts, 0.3, term="surface")
+        b = model.brdf(ts, ti, 0.3, term="surface")
+        if vm_on:
+            assert abs(a / b / ratio - 1) > 0.05
+        else:
+            assert a / b == pytest.approx(ratio, rel=1e-12)
+
+
+# ------------------------------------------------------------------------------------------
+# parameters, options, terms, polarization, broadcasting, invalid input
+# ------------------------------------------------------------------------------------------
+def test_registry_parameters_and_docs():
+    for name in ("renhorn-boreman-2008", "rb08", "Renhorn-Boreman", "RB08"):
+        assert isinstance(rb.model(name), rbm.RenhornBoreman2008)
+    m = rb.model("rb08")
+    assert m.param_names == P_NAMES
+    assert m.short == "rb08" and m.TERMS == ("surface", "bulk", "retro")
+    for p in m.parameters:
+        assert p.unit and p.description and p.bounds[0] < p.bounds[1]
+        assert p.bounds[0] <= p.value <= p.bounds[1]
+    doc = rbm.RenhornBoreman2008.__doc__
+    for word in ("Certain", "our reading", "Not reciprocal", "12892", "pi/2"):
+        assert word.lower() in doc.lower(), word
+    assert m.options == {"zeta": "angle", "surface_weight": "geometric-mean",
+                         "normalization": "literal", "polarization": "unpolarized"}
+    assert rb.model(m.to_dict()).brdf(0.3, 0.4, 0.5) == m.brdf(0.3, 0.4, 0.5)
+    # option spellings: underscores, case
+    m2 = rb.model("rb08", zeta="Zenith_Difference", normalization="SPECULAR_WIDTH")
+    assert m2.options["zeta"] == "zenith-difference"
+    assert m2.options["normalization"] == "specular-width"
+
+
+def test_default_surface_is_matte_paint_like():
+    m = rb.model("rb08")
+    # mostly diffuse: directional-hemispherical reflectance ~0.8, a weak gloss lobe
+    alb = rb.albedo(m, deg([0.0, 45.0]))
+    assert np.all((alb > 0.7) & (alb < 1.0))
+    spec = m.brdf(deg(45), deg(45), 0.0)
+    diffuse = m.brdf(deg(45), deg(10), math.pi / 2)
+    assert 1.0 < spec / diffuse < 5.0
+
+
+@pytest.mark.parametrize("name, bad", [
+    ("rho", 0.0), ("rho", -0.1), ("w", 0.0), ("w", -1.0), ("n", -0.5), ("bulk", -0.1),
+    ("retro", -1e-3), ("rho_r", 0.0), ("w_r", -0.2), ("n_r", -1.0), ("gamma", -0.5),
+    ("n_eff", 0.0), ("k_eff", -0.1), ("rho", math.nan), ("w_a", math.inf),
+])
+def test_bad_parameter_raises_naming_it(name, bad):
+    with pytest.raises(ValueError, match=repr(name)):
+        rb.model("rb08", **{name: bad})
+    with pytest.raises(ValueError, match=repr(name)):
+        rb.model("rb08").with_values([name], [bad])
+
+
+@pytest.mark.parametrize("option, bad", [("zeta", "sine"), ("surface_weight", "mean"),
+                                         ("normalization", "exact"), ("polarization", "x")])
+def test_bad_option_raises_naming_it(option, bad):
+    with pytest.raises(ValueError, match=rf"'{option}'.*{bad}|{bad}.*'{option}'"):
+        rb.model("rb08", **{option: bad})
+
+
+def test_unknown_keyword_and_term():
+    with pytest.raises(ValueError, match="sigma"):
+        rb.model("rb08", sigma=1.0)
+    m = rb.model("rb08")
+    with pytest.raises(ValueError, match="specular"):
+        m.brdf(0.3, 0.3, 0.0, term="specular")
+
+
+def test_terms_sum_and_sum_model_routing():
+    m = rb.model("rb08", **FULL)
+    ti, ts, ph = random_geometry(500, seed=4)
+    parts = [m.brdf(ti, ts, ph, term=t) for t in m.TERMS]
+    np.testing.assert_allclose(sum(parts), m.brdf(ti, ts, ph), rtol=1e-14)
+    np.testing.assert_allclose(sum(m.bridf(ti, ts, ph, term=t) for t in m.TERMS),
+                               m.bridf(ti, ts, ph), rtol=1e-14)
+    s = m + rb.model("lambertian", rho=0.2)
+    np.testing.assert_allclose(s.brdf(ti, ts, ph, term="retro"), parts[2], rtol=1e-15)
+    np.testing.assert_allclose(s.brdf(ti, ts, ph), m.brdf(ti, ts, ph) + 0.2 / math.pi,
+                               rtol=1e-14)
+    # zero strengths give exactly zero terms
+    z = rb.model("rb08", bulk=0.0, retro=0.0)
+    assert z.brdf(0.4, 0.4, math.pi, term="retro") == 0.0
+    assert z.brdf(0.4, 0.1, 1.0, term="bulk") == 0.0
+
+
+def test_polarization_option_and_per_call_argument():
+    ti, ts, ph = random_geometry(300, seed=8)
+    base = rb.model("rb08", **FULL)
+    s_opt = rb.model("rb08", polarization="s", **FULL)
+    p_opt = rb.model("rb08", polarization="p", **FULL)
+    np.testing.assert_allclose(base.brdf(ti, ts, ph, polarization="s"), s_opt.brdf(ti, ts, ph),
+                               rtol=1e-15)
+    np.testing.assert_allclose(base.brdf(ti, ts, ph, polarization=HALF_PI),
+                               s_opt.brdf(ti, ts, ph), rtol=1e-15)
+    np.testing.assert_allclose(s_opt.brdf(ti, ts, ph, polarization=0.0), p_opt.brdf(ti, ts, ph),
+                               rtol=1e-15)
+    np.testing.assert_allclose(p_opt.brdf(ti, ts, ph, polarization=None), p_opt.brdf(ti, ts, ph),
+                               rtol=0)
+    # one angle per sample; NaN entries use the option
+    gam = np.where(np.arange(300) % 3 == 0, math.nan, np.where(np.arange(300) % 3 == 1,
+                                                               HALF_PI, 0.0))
+    mixed = p_opt.brdf(ti, ts, ph, polarization=gam)
+    want = np.where(np.arange(300) % 3 == 1, s_opt.brdf(ti, ts, ph), p_opt.brdf(ti, ts, ph))
+    np.testing.assert_allclose(mixed, want, rtol=1e-15)
+    # a general angle: R = R_s sin^2 g + R_p cos^2 g in both Fresnel factors
+    g = 0.6
+    r = [fresnel_eq16_17(x, FULL["n_eff"], FULL["k_eff"]) for x in (math.sin(0.5),
+                                                                     math.sin(0.9))]
+    r0, rs = ((a * math.sin(g) ** 2 + b * math.cos(g) ** 2) for a, b in r)
+    bulk = base.brdf(0.5, 0.9, 1.0, polarization=g, term="bulk")
+    assert bulk == pytest.approx((1 - math.sqrt(r0 * rs)) * FULL["bulk"] / math.pi, rel=1e-12)
+
+
+def test_n_dimensional_broadcasting():
+    for params in ({}, dict(FULL)):
+        m = rb.model("rb08", **params)
+        rng = np.random.default_rng(1)
+        ti = rng.uniform(0, 1.5, (3, 1, 1, 2))
+        ts = rng.uniform(0, HALF_PI, (1, 4, 1, 1))
+        ph = rng.uniform(-3, 3, (5, 1))
+        got = m.brdf(ti, ts, ph)
+        assert got.shape == (3, 4, 5, 2)
+        a, b, c = np.broadcast_arrays(ti, ts, ph)
+        loop = np.array([m.brdf(x, y, z) for x, y, z in zip(a.ravel(), b.ravel(), c.ravel(),
+                                                            strict=True)])
+        np.testing.assert_allclose(got.ravel(), loop, rtol=1e-14)
+        for t in m.TERMS:
+            assert m.brdf(ti, ts, ph, term=t).shape == (3, 4, 5, 2)
+        assert isinstance(m.brdf(0.1, 0.2, 0.3), float)
+        assert m.brdf(np.zeros((0, 3)), 0.2, 0.0).shape == (0, 3)
+
+
+@pytest.mark.parametrize("which", ["theta_i", "theta_r", "phi"])
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+def test_nan_and_inf_angles_raise(which, bad):
+    args = {"theta_i": np.array([0.2, 0.3]), "theta_r": 0.4, "phi": 0.1}
+    args[which] = np.array([0.2, bad])
+    with pytest.raises(ValueError, match=which):
+        rb.model("rb08").brdf(**args)
+
+
+def test_grazing_incidence_rejected():
+    m = rb.model("rb08")
+    assert m.grazing_incidence is False
+    with pytest.raises(ValueError, match="theta_i"):
+        m.brdf(HALF_PI, 0.3, 0.0)
+    # just below grazing: finite everywhere, the lobes very narrow but finite
+    ti = np.nextafter(HALF_PI, 0.0)
+    f = m.brdf(ti, np.array([ti, ti, 1.0, HALF_PI]), np.array([0.0, math.pi, 0.5, 0.0]))
+    assert np.all(np.isfinite(f)) and np.all(f > 0)
+
+
+def test_special_points_finite_all_options():
+    ti = np.array([0.0, 0.0, 0.5, 0.5, 0.5, 1.2, 1.2, 1.5, 1e-12, 0.5])
+    ts = np.array([0.0, HALF_PI, 0.5, 0.5, HALF_PI, 1.2, 1.2, 1.5, 1e-12, 0.0])
+    ph = np.array([0.0, 1.0, 0.0, math.pi, 0.3, 0.0, -math.pi, 0.0, HALF_PI, 2.0])
+    for opts in OPTION_SETS + [{"normalization": "numeric"}]:
+        for params in ({}, FULL):
+            m = rb.model("rb08", **opts, **params)
+            for f in (m.brdf(ti, ts, ph), m.bridf(ti, ts, ph)):
+                assert np.all(np.isfinite(f)) and np.all(f >= 0), (opts, params, f)
+            assert m.bridf(0.4, HALF_PI, 0.2) == 0.0
+
+
+def test_vanishing_width_gives_inf_not_nan():
+    # extremely sharp shadowing: V(sin theta_i) underflows to 0, the lobe's width vanishes and
+    # its peak is the limit +inf (documented); every other direction stays finite
+    m = rb.model("rb08", w=0.3, n=500, w_r=0.3, n_r=500)
+    assert float(rb.shadowing.V(math.sin(1.2), 0.3, 500)) == 0.0
+    f = m.brdf(1.2, np.array([1.2, 1.2, 1.1]), np.array([0.0, math.pi, 0.0]))
+    assert f[0] == math.inf and np.isfinite(f[2])
+    assert f[1] > 1e20  # the retro peak: phi = pi is not exact in floating point (sin pi != 0)
+    assert m.bridf(1.2, 1.2, 0.0) == math.inf

@@ -50,7 +50,7 @@ from numba.extending import overload
 DISABLE_JIT: bool = bool(numba.config.DISABLE_JIT)
 
 __all__ = ["DISABLE_JIT", "jit", "ufunc", "driver", "at", "sincos", "evaluate", "as_float_array",
-           "SINCOS_MAX_ARG"]
+           "SINCOS_MAX_ARG", "TINY"]
 
 
 # --------------------------------------------------------------------------------------------
@@ -194,6 +194,9 @@ def _at_overload(x, i):  # pragma: no cover - compiled
 # Cody-Waite reduction by pi/2 in three 33-bit parts (fdlibm e_rem_pio2.c: pio2_1, pio2_2,
 # pio2_3): k * pio2_j is exact for |k| < 2**20, so the reduced argument is accurate for
 # |x| <= SINCOS_MAX_ARG. Polynomials on [-pi/4, pi/4]: fdlibm k_sin.c / k_cos.c (< 1 ulp).
+#: added to a denominator that may be exactly 0 where the quotient is then discarded or 0/TINY
+#: = 0; LLVM evaluates both sides of selects, and NumPy reports a 0/0 in a ufunc as a warning
+TINY = 1e-300
 SINCOS_MAX_ARG = 2.0**19 * 0.5 * math.pi  # 8.2e5 rad; front ends reduce larger azimuths
 _INVPIO2 = 6.36619772367581382433e-01
 _PIO2_1 = 1.57079632673412561417e00

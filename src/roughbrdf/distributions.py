@@ -140,14 +140,16 @@ def peak(code, c, a):
     if code == GAUSS_ANGLE:
         x = a * math.acos(c) * _DEG
         return math.exp(-x * x)
-    if c == 0.0:
-        # Beckmann/Sirohi: exp(-A tan^2) beats any power of 1/cos at grazing; the limit is 0.
+    if c < 1e-150:
+        # Beckmann/Sirohi: exp(-A tan^2) beats any power of 1/cos at grazing; the limit is 0
+        # (and tan^2 > 1e300 here: the value underflows for every width parameter in range).
         return 0.0
-    c2 = c * c
-    t2 = s2 / c2
+    # exp(-x tan^2) / cos^p as one exponential: for tiny c, cos^p underflows to 0 (0/0 in the
+    # quotient) while the exponent goes to -inf first, so the log form gives the limit 0.
+    t2 = s2 / (c * c)
     if code == BECKMANN:
-        return math.exp(-t2 / (a * a)) / (c2 * c2)
-    return math.exp(-a * t2) / c2  # SIROHI
+        return math.exp(-t2 / (a * a) - 4.0 * math.log(c))
+    return math.exp(-a * t2 - 2.0 * math.log(c))  # SIROHI
 
 
 @jit
@@ -166,7 +168,8 @@ def lambda_cos(code, c, a):
     if s == 0.0:
         return 0.0  # normal direction: no masking, Lambda = 0
     u = c / (a * s)
-    return 0.5 * c * (math.erf(u) - 1.0) + 0.5 * a * s * math.exp(-u * u) / _SQRT_PI
+    # erfc instead of erf - 1 (no cancellation); Lambda >= 0, so clip the round-off below 0
+    return max(0.0, 0.5 * a * s * math.exp(-u * u) / _SQRT_PI - 0.5 * c * math.erfc(u))
 
 
 @ufunc(3)

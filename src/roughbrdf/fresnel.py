@@ -31,7 +31,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._jit import as_float_array, jit, sincos, ufunc
+from ._jit import TINY, as_float_array, jit, sincos, ufunc
 
 __all__ = ["fresnel_sp", "fresnel_polarized", "fresnel_polarized_cs", "reflectance",
            "polarization_angle", "check_index"]
@@ -47,20 +47,22 @@ def fresnel_sp(c, n, k):
     mod = math.sqrt(zr * zr + im * im)
     # principal square root q = a + ib of z = zr + i im, computed without cancellation: the
     # larger component is t = sqrt((|z| + |zr|)/2), the other one im/(2 t). Written with
-    # selects (no branches) and guarded denominators, so that vectorized code, which evaluates
-    # both sides, never divides by zero (NumPy would report it as a warning in the ufuncs).
+    # selects (no branches), and every denominator that can be 0 gets + TINY: compiled code
+    # evaluates both sides of a select (LLVM also turns x/(d if d > 0 else 1) into one), and a
+    # 0/0 there would show up as a NumPy RuntimeWarning in the ufuncs. TINY = 1e-300 changes
+    # no result: it is below the last bit of every non-zero denominator.
     t = math.sqrt(0.5 * (mod + abs(zr)))
-    u = 0.5 * im / (t if t > 0.0 else 1.0)  # t = 0 only if z = 0, and then im = 0: u = 0
+    u = 0.5 * im / (t + TINY)  # t = 0 only if z = 0, and then im = 0: u = 0
     a = t if zr >= 0.0 else u
     b = u if zr >= 0.0 else t
     # den = 0 only for n + ik = 1 at exactly grazing incidence (z = 0, c = 0): index matched,
     # no interface; the limit along c -> 0 is R = 0, which the guarded quotients give.
     den = (c + a) * (c + a) + b * b
-    rs = ((c - a) * (c - a) + b * b) / (den if den > 0.0 else 1.0)
+    rs = ((c - a) * (c - a) + b * b) / (den + TINY)
     pr = re * c
     pi_ = im * c
     denp = (pr + a) * (pr + a) + (pi_ + b) * (pi_ + b)
-    rp = ((pr - a) * (pr - a) + (pi_ - b) * (pi_ - b)) / (denp if denp > 0.0 else 1.0)
+    rp = ((pr - a) * (pr - a) + (pi_ - b) * (pi_ - b)) / (denp + TINY)
     return rs, rp
 
 

@@ -36,7 +36,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._jit import SINCOS_MAX_ARG, as_float_array, jit, sincos, ufunc
+from ._jit import SINCOS_MAX_ARG, TINY, as_float_array, jit, sincos, ufunc
 
 HALF_PI = 0.5 * math.pi
 
@@ -142,10 +142,12 @@ def half_vector(ti, tr, phi):
     sz = ci + cr
     length = math.sqrt(sx * sx + sy * sy + sz * sz)
     if length == 0.0:
-        # w_i = -w_r: both grazing and opposite (retro at theta = 90 deg). No facet can connect
-        # them; return a horizontal "half vector" with cos_d = 0 so every model gives 0 there.
+        # w_i = -w_r: theta_i = theta_r = 90 deg and phi = 0 (the forward grazing pair). The
+        # half vector is undefined and the limits depend on the path (G -> 1 along the specular
+        # direction, G = 0 at grazing incidence). Return a horizontal "half vector" with
+        # cos_d = 0, so that every model gives its shadowed limit (nothing reflects) there.
         return 1.0, 0.0, 0.0, 0.0, ci, cr, si
-    inv = 1.0 / (length if length > 0.0 else 1.0)  # guarded: vectorized code runs both sides
+    inv = 1.0 / (length + TINY)  # TINY: see roughbrdf._jit (compiled code runs both sides)
     return sx * inv, sy * inv, sz * inv, 0.5 * length, ci, cr, si
 
 
@@ -164,13 +166,12 @@ def ts67_projected(ti, tr, phi):
     wrx = sr * cp
     wry = sr * sp
     hxy = math.sqrt(hx * hx + hy * hy)
-    if hxy > 1e-300:
-        ux = hx / hxy
-        uy = hy / hxy
-    else:
-        # alpha = 0 (specular): any horizontal u works; take the plane of incidence.
-        ux = 1.0
-        uy = 0.0
+    # alpha = 0 (specular): any horizontal u works; take the plane of incidence. (TINY keeps
+    # compiled code, which evaluates both sides of the select, free of 0/0.)
+    tilted = hxy > 1e-300
+    inv = 1.0 / (hxy + TINY)
+    ux = hx * inv if tilted else 1.0
+    uy = hy * inv if tilted else 0.0
     alpha = math.acos(min(1.0, hz))
     a_i = math.atan2(-si * ux, ci)
     a_r = math.atan2(wrx * ux + wry * uy, cr)
@@ -198,7 +199,7 @@ def tr75_eta_cs(si, ci, hx, hy, hz):
     """
     x = si * hz + ci * hx
     length = math.sqrt(x * x + hy * hy)
-    inv = 1.0 / (length if length > 0.0 else 1.0)
+    inv = 1.0 / (length + TINY)
     if length > 0.0:
         return x * inv, hy * inv
     return 1.0, 0.0

@@ -84,8 +84,13 @@ def albedo(model: Model, theta_i: ArrayLike, *, polarization=None, n_psi: int = 
 
 def reciprocity_error(model: Model, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike
                       ) -> np.ndarray:
-    """Relative difference ``|f(i, r) - f(r, i)| / max(f)`` (0 for a reciprocal model)."""
+    """Relative difference ``|f(i, r) - f(r, i)| / max(f)`` (0 for a reciprocal model).
+
+    Equal values, infinite ones included (a model's limit at the horizon), give 0.
+    """
     a = np.asarray(model.brdf(theta_i, theta_r, phi))
     b = np.asarray(model.brdf(theta_r, theta_i, phi))
     scale = np.maximum(np.maximum(np.abs(a), np.abs(b)), 1e-300)
-    return np.abs(a - b) / scale
+    with np.errstate(invalid="ignore"):  # inf - inf
+        err = np.abs(a - b) / scale
+    return np.where(a == b, 0.0, err)

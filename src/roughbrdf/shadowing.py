@@ -37,7 +37,7 @@ from numpy.typing import ArrayLike
 
 from . import distributions as _dist
 from . import special as _special
-from ._jit import as_float_array, jit, ufunc
+from ._jit import TINY, as_float_array, jit, ufunc
 from .geometry import check_angles, half_vector, ts67_projected
 
 __all__ = [
@@ -108,7 +108,8 @@ def v_groove_g(ci, cr, ch, cd):
     """Scalar TS67 V-groove G from cosines (closed form, MODELS.md §2.5)."""
     if cd <= 0.0:
         return 0.0  # w_i = -w_r (grazing, opposite): nothing reflects
-    return min(1.0, 2.0 * ch * cr / cd, 2.0 * ch * ci / cd)
+    # + TINY: compiled code may evaluate this side also when cd = 0 (see roughbrdf._jit.TINY)
+    return min(1.0, 2.0 * ch * cr / (cd + TINY), 2.0 * ch * ci / (cd + TINY))
 
 
 @jit(inline=True)
@@ -120,24 +121,52 @@ def v_groove_g_over_cos_r(ci, cr, ch, cd):
     """
     if cd <= 0.0:
         return 0.0
-    masking = 2.0 * ch / cd
+    masking = 2.0 * ch / (cd + TINY)  # + TINY: see roughbrdf._jit.TINY
     if cr <= 0.0:
         return masking  # the G=1 and shadowing candidates are +inf at theta_r = 90 deg
-    return min(1.0 / cr, masking, masking * ci / cr)
+    inv_cr = 1.0 / (cr + TINY)
+    return min(inv_cr, masking, masking * ci * inv_cr)
+
+
+@jit(inline=True)
+def v_groove_g_over_cos_cos(ci, cr, ch, cd):
+    """Scalar TS67 ``G/(cos theta_i cos theta_r)`` per branch (microfacet and absolute forms).
+
+    G is symmetric in (i, r), so ``G/cos`` of the *smaller* cosine is a per-branch quotient
+    that stays finite (:func:`v_groove_g_over_cos_r` with the arguments in either order), and
+    only the larger cosine is divided by. Finite unless both directions are exactly grazing,
+    where the limit is ``inf`` (0 if nothing reflects, ``cd = 0``).
+    """
+    if ci >= cr:
+        g_c = v_groove_g_over_cos_r(ci, cr, ch, cd)  # G / cos(theta_r)
+        big = ci
+    else:
+        g_c = v_groove_g_over_cos_r(cr, ci, ch, cd)  # G / cos(theta_i), by symmetry
+        big = cr
+    if big > 0.0:
+        return g_c / (big + TINY)
+    return math.inf if g_c > 0.0 else 0.0
 
 
 @jit
 def g21(psi_p, theta_p):
     """TS67 Eq. 21 in the cancellation-free form ``G = 1 - A/(1 + sqrt(1 - A^2))``."""
     hd = 0.5 * (theta_p - psi_p)
-    c2 = math.cos(hd) ** 2
-    st2 = math.sin(theta_p) ** 2
+    ch = math.cos(hd)
+    c2 = ch * ch
+    st = math.sin(theta_p)
+    st2 = st * st
     den = c2 - math.cos(theta_p - psi_p) * st2
     if den == 0.0:
         return 0.0  # A -> infinity only at the boundary theta_p = +-pi/2, where G = 0
     a = (st2 - c2) / den
-    # clip 1 - A^2 >= 0: round-off can push |A| slightly above 1 at theta_p = +-pi/2
-    return 1.0 - a / (1.0 + math.sqrt(max(0.0, 1.0 - a * a)))
+    # 1 - A^2 without cancellation near |A| = 1 (theta_p -> +-pi/2): with
+    # 1 + cos(theta_p - psi_p) = 2 cos^2(hd), one finds 1 - A = 2 cos^2(hd) cos^2(theta_p)/den
+    # and 1 + A = 2 sin^2(theta_p) sin^2(hd)/den, so sqrt(1 - A^2) is the product below.
+    root = abs(2.0 * ch * math.cos(theta_p) * st * math.sin(hd) / den)
+    # G in [0, 1] (the minus root of Eq. 21a); round-off at the boundaries (A = 0, A = 1)
+    # can step outside
+    return min(1.0, max(0.0, 1.0 - a / (1.0 + min(1.0, root))))
 
 
 @jit
@@ -183,10 +212,7 @@ def g_over_cos_cos(code, dcode, a, ci, cr, ch, cd):
         den = ci * cr
         return 1.0 / den if den > 0.0 else math.inf  # the no-shadowing form diverges: limit inf
     if code == V_GROOVE:
-        if ci <= 0.0:
-            # G <= 2 ch ci/cd -> G/ci <= 2 ch/cd: the shadowing candidate stays finite
-            return _safe_div(2.0 * ch, cd * cr) if cd > 0.0 else 0.0
-        return v_groove_g_over_cos_r(ci, cr, ch, cd) / ci
+        return v_groove_g_over_cos_cos(ci, cr, ch, cd)
     return smith_g_over_cos_cos(code, dcode, a, ci, cr)
 
 
@@ -255,7 +281,7 @@ def smith_g1(cos_theta: ArrayLike, alpha: float, distribution: str = "trowbridge
 
 @ufunc(5)
 def _smith_g(code, dcode, a, ci, cr):
-    return smith_g_over_cos_cos(int(code), int(dcode), a, ci, cr) * ci * cr
+    return min(1.0, smith_g_over_cos_cos(int(code), int(dcode), a, ci, cr) * ci * cr)
 
 
 def smith(theta_i: ArrayLike, theta_r: ArrayLike, alpha: float,

@@ -38,14 +38,16 @@ def _micro_point(ti, tr, phi, gamma, p, flag):
     d = dist.evaluate_d(dcode, hz, alpha, norm)
     if flag:  # BRIDF = f_r cos(theta_r): the 1/cos(theta_r) is never formed
         if scode == shd.NONE:
-            geo = 1.0 / ci
+            geo = 1.0 / ci if ci > 0.0 else math.inf  # unshadowed: diverges at grazing incidence
         elif scode == shd.V_GROOVE:
-            geo = shd.v_groove_g(ci, cr, hz, cd) / ci
+            geo = shd.v_groove_g_over_cos_r(cr, ci, hz, cd)  # G/cos(theta_i) (G symmetric)
         else:
             geo = shd.smith_g_over_cos_cos(scode, dcode, alpha, ci, cr) * cr
     else:
         geo = shd.g_over_cos_cos(scode, dcode, alpha, ci, cr, hz, cd)
-    return 0.25 * ks * f * d * geo
+    t = ks * f * d
+    # t = 0 (F = 0, or D underflowed far from its peak) gives 0 there, never 0 * inf
+    return 0.25 * t * geo if t > 0.0 else 0.0
 
 
 @register

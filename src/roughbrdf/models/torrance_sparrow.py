@@ -27,7 +27,7 @@ from .. import distributions as dist
 from .._jit import jit
 from ..fresnel import check_index, fresnel_polarized
 from ..geometry import half_vector, tr75_eta_from_h
-from ..shadowing import v_groove_g, v_groove_g_over_cos_r
+from ..shadowing import v_groove_g_over_cos_cos, v_groove_g_over_cos_r
 from .base import Model, Parameter, nonnegative, positive, register
 
 
@@ -41,9 +41,15 @@ def _ts67_point(ti, tr, phi, gamma, p, flag):
     else:
         f = 1.0
     gauss = dist.peak(dist.GAUSS_ANGLE, hz, c)  # exp(-(c alpha_deg)^2), TS67 Eq. 5
-    if flag:  # BRIDF: f_r cos(theta_r) -> G itself, no 1/cos(theta_r)
-        return rho_d / math.pi * (g * f * v_groove_g(ci, cr, hz, cd) * gauss / ci + cr)
-    return rho_d / math.pi * (g * f * v_groove_g_over_cos_r(ci, cr, hz, cd) * gauss / ci + 1.0)
+    t = g * f * gauss
+    if flag:  # BRIDF: f_r cos(theta_r) = rho_d/pi [g F gauss G/cos(theta_i) + cos(theta_r)]
+        # G/cos(theta_i) per branch (symmetry of G): finite also where cos(theta_i) rounds to 0
+        geo = v_groove_g_over_cos_r(cr, ci, hz, cd)
+        return rho_d / math.pi * ((t * geo if t > 0.0 else 0.0) + cr)
+    # G/(cos theta_i cos theta_r) per branch: finite at theta_r = 90 deg (MODELS.md §2.5) and
+    # where cos(theta_i) rounds to 0; t = 0 (gaussian underflow) gives 0, never 0 * inf
+    geo = v_groove_g_over_cos_cos(ci, cr, hz, cd)
+    return rho_d / math.pi * ((t * geo if t > 0.0 else 0.0) + 1.0)
 
 
 @register
@@ -57,7 +63,8 @@ class TorranceSparrow1967(Model):
     c : float
         Width of the gaussian facet-angle distribution, **per degree** (0.05 in the paper).
     n, k : float or None
-        Complex index ``n + i k`` of the facet material; ``n=None`` sets ``F = 1`` (Figs. 8, 10, 11).
+        Complex index ``n + i k`` of the facet material; ``n=None`` sets ``F = 1``
+        (Figs. 8, 10, 11).
     rho_d : float
         Scale of the absolute form: ``rho_d/pi`` is the diffuse BRDF (sr⁻¹).
 

@@ -39,17 +39,20 @@ def _tr75_point(ti, tr, phi, gamma, p, flag):
     hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
     ce, se = tr75_eta_cs(si, ci, hx, hy, hz)  # eta, TR75 Eq. 23 (MODELS.md §3.5)
     r = fresnel_polarized_cs(cd, n, k, gamma, ce, se)
-    spec = r * dist.trowbridge_reitz_d(hz, e) / (4.0 * ci)
+    spec4 = 0.25 * r * dist.trowbridge_reitz_d(hz, e)  # R D/4; Eq. 30 = spec4/cos(theta_i)
     if flag:  # BRIDF, Eq. 33
-        if shadow > 0.0:
-            spec *= shd.v_groove_g(ci, cr, hz, cd)
+        if shadow > 0.0:  # G/cos(theta_i) per branch (G symmetric), finite at grazing
+            spec = spec4 * shd.v_groove_g_over_cos_r(cr, ci, hz, cd)
+        else:  # Eq. 30 diverges as 1/cos(beta) at grazing incidence (MODELS.md §3.13): inf
+            spec = spec4 / ci if ci > 0.0 else math.inf
         return spec + cr * rho_l / math.pi
     # BRDF = BRIDF / cos(theta_r)
     if shadow > 0.0:
-        return spec * shd.v_groove_g_over_cos_r(ci, cr, hz, cd) + rho_l / math.pi
-    if cr <= 0.0:
+        return spec4 * shd.v_groove_g_over_cos_cos(ci, cr, hz, cd) + rho_l / math.pi
+    den = ci * cr
+    if den <= 0.0:
         return math.inf  # unshadowed Eq. 30 over cos(theta_r) diverges at the horizon
-    return spec / cr + rho_l / math.pi
+    return spec4 / den + rho_l / math.pi
 
 
 @driver

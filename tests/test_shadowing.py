@@ -9,7 +9,7 @@ import warnings
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import roughbrdf as rb
@@ -52,6 +52,8 @@ def test_table_i_equals_closed_form_in_plane_and_edges():
 @settings(max_examples=200, deadline=None)
 @given(ti=st.floats(0, HALF_PI), tr=st.floats(0, HALF_PI), ph=st.floats(-np.pi, np.pi))
 def test_table_i_equals_closed_form_property(ti, tr, ph):
+    # (w_i = -w_r, theta_i = theta_r = 90 deg at phi = 0, has no half vector: see above)
+    assume(not (ti == tr == HALF_PI and math.cos(ph) > 0.5))
     assert S.v_groove_table(ti, tr, ph) == pytest.approx(S.v_groove(ti, tr, ph), abs=1e-10)
 
 

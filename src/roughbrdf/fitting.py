@@ -782,7 +782,8 @@ def _channel_weights(weights: Any, meas: Measurement, j: int, x: np.ndarray, los
 
 _EXCLUDED_WORDS = {"nonfinite": "non-finite", "negative": "negative (dropped)",
                    "clipped": "negative (clipped)", "zero_weight": "of zero weight",
-                   "model_domain": "where the model is not finite or not defined"}
+                   "model_domain": "where the model is not finite, not defined, or BRDF cos "
+                                   "theta_r = 0 (theta_r = 90 deg)"}
 
 
 def _excluded_text(excluded: dict[str, int]) -> str:
@@ -836,6 +837,12 @@ def _prepare_channel(model: Model, meas: Measurement, j: int, flag: int, loss: s
         graze = keep & (meas.theta_i >= 0.5 * math.pi)
         excluded["model_domain"] += int(graze.sum())
         keep &= ~graze
+    if flag == 1 and loss != "absolute":
+        # BRDF cos(theta_r) of every model is 0 at theta_r = 90 deg: a measured value there (a
+        # noise floor) has no relative or logarithmic residual
+        horizon = keep & (np.cos(meas.theta_r) <= 1e-12)
+        excluded["model_domain"] += int(horizon.sum())
+        keep &= ~horizon
     # samples where the model itself is not finite at the starting values (e.g. the BRDF of the
     # unshadowed TR75 model at theta_r = 90 deg, which is +inf): these cannot be fitted
     idx = np.flatnonzero(keep)

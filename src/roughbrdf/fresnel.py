@@ -33,7 +33,8 @@ from numpy.typing import ArrayLike
 
 from ._jit import TINY, as_float_array, jit, sincos, ufunc
 
-__all__ = ["fresnel_sp", "fresnel_polarized", "fresnel_polarized_cs", "reflectance",
+__all__ = ["fresnel_sp", "fresnel_polarized", "fresnel_polarized_cs", "fresnel_polarized_xy",
+           "reflectance",
            "polarization_angle", "check_index"]
 
 
@@ -58,12 +59,30 @@ def fresnel_sp(c, n, k):
     # den = 0 only for n + ik = 1 at exactly grazing incidence (z = 0, c = 0): index matched,
     # no interface; the limit along c -> 0 is R = 0, which the guarded quotients give.
     den = (c + a) * (c + a) + b * b
-    rs = ((c - a) * (c - a) + b * b) / (den + TINY)
     pr = re * c
     pi_ = im * c
     denp = (pr + a) * (pr + a) + (pi_ + b) * (pi_ + b)
-    rp = ((pr - a) * (pr - a) + (pi_ - b) * (pi_ - b)) / (denp + TINY)
+    inv = 1.0 / (den * denp + TINY)  # one division for both quotients
+    rs = ((c - a) * (c - a) + b * b) * denp * inv
+    rp = ((pr - a) * (pr - a) + (pi_ - b) * (pi_ - b)) * den * inv
     return rs, rp
+
+
+@jit(inline=True)
+def fresnel_polarized_xy(c, n, k, gamma, x, y):
+    """TR75 Eq. 24 with ``eta`` given by any vector ``(x, y)`` along ``(cos eta, sin eta)``.
+
+    ``sin^2(gamma - eta) = (sin(gamma) x - cos(gamma) y)^2/(x^2 + y^2)``: no square root and
+    no normalization (:func:`roughbrdf.geometry.tr75_eta_xy` gives ``sin(s) (cos eta,
+    sin eta)``). Where ``(x, y)`` vanishes (s = 0, R_s = R_p) the result is R_p = R_s.
+    """
+    rs, rp = fresnel_sp(c, n, k)
+    unpolarized = gamma != gamma  # NaN encodes "unpolarized"
+    sg, cg = sincos(0.0 if unpolarized else gamma)  # no arithmetic on the NaN (ufunc warnings)
+    d = sg * x - cg * y
+    sn2 = d * d / (x * x + y * y + TINY)
+    pol = rs * sn2 + rp * (1.0 - sn2)
+    return 0.5 * (rs + rp) if unpolarized else pol
 
 
 @jit(inline=True)

@@ -196,6 +196,12 @@ def tr75_eta_from_h(si, ci, hx, hy, hz):
 
 
 @jit(inline=True)
+def tr75_eta_xy(si, ci, hx, hy, hz):
+    """``sin(s) (cos eta, sin eta)`` of :func:`tr75_eta_from_h`, unnormalized (no sqrt)."""
+    return si * hz + ci * hx, hy
+
+
+@jit(inline=True)
 def tr75_eta_cs(si, ci, hx, hy, hz):
     """``(cos eta, sin eta)`` of :func:`tr75_eta_from_h` without ``atan2`` (vectorizable).
 

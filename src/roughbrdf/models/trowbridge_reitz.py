@@ -28,8 +28,8 @@ from numba import prange
 from .. import distributions as dist
 from .. import shadowing as shd
 from .._jit import at, driver, jit
-from ..fresnel import check_index, fresnel_polarized_cs
-from ..geometry import half_vector, tr75_eta_cs
+from ..fresnel import check_index, fresnel_polarized_xy
+from ..geometry import half_vector, tr75_eta_xy
 from .base import Model, nonnegative, positive, register, unit_interval
 
 
@@ -37,8 +37,8 @@ from .base import Model, nonnegative, positive, register, unit_interval
 def _tr75_point(ti, tr, phi, gamma, p, flag):
     e, n, k, rho_l, shadow = p[0], p[1], p[2], p[3], p[4]
     hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
-    ce, se = tr75_eta_cs(si, ci, hx, hy, hz)  # eta, TR75 Eq. 23 (MODELS.md §3.5)
-    r = fresnel_polarized_cs(cd, n, k, gamma, ce, se)
+    ex, ey = tr75_eta_xy(si, ci, hx, hy, hz)  # sin(s) (cos, sin) eta, Eq. 23 (MODELS.md §3.5)
+    r = fresnel_polarized_xy(cd, n, k, gamma, ex, ey)
     spec4 = 0.25 * r * dist.trowbridge_reitz_d(hz, e)  # R D/4; Eq. 30 = spec4/cos(theta_i)
     if flag:  # BRIDF, Eq. 33
         if shadow > 0.0:  # G/cos(theta_i) per branch (G symmetric), finite at grazing

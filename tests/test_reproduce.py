@@ -322,6 +322,9 @@ def test_run_and_cli(tmp_path):
     assert res.exit_code == 2 and "unknown paper" in res.output
     with pytest.raises(ValueError, match="unknown paper"):
         run("nope", out)
+    res = runner.invoke(app, ["reproduce", "--paper", "rb08", "--out", str(tmp_path / "r2"),
+                              "--data", str(tmp_path / "nowhere")])
+    assert res.exit_code == 2 and "gray tape" in res.output
 
 
 # ---------------------------------------------------------------------------------------------
@@ -361,13 +364,46 @@ def test_rb08_fig3_two_orders_of_magnitude(rbr):
     for c in curves.columns[1:]:
         y = curves.column(c)
         assert np.all(np.isfinite(y)) and np.all(y > 0), c
-    # the surface lobe peaks near the specular direction for oblique incidence
+    # the gray tape is a retro-reflector: each curve peaks at the retro direction -theta_i
     for row in rng.rows[:-1]:
         ti, tmax = row[0], row[3]
-        if ti >= 40:
-            assert abs(tmax - ti) < 5.0, (ti, tmax)
+        assert tmax == pytest.approx(-ti, abs=1.0), (ti, tmax)
     params = dict(rbr["rb08_fig03"].tables["params"].rows)
     assert len(params) == 14
+    assert "retro_peaks" not in rbr["rb08_fig03"].tables  # no data overlay by default
+
+
+def test_rb08_gray_tape_parameters_match_the_published_fit(rbr):
+    """rb08.CEA_GRAY_TAPE reproduces docs/fitting.md: model retro peaks (BRDF cos) 137, 96.3
+    and 3.51 at 15, 30 and 60 deg."""
+    from roughbrdf.reproduce import rb08
+
+    m = rb08.model(rb08.CEA_GRAY_TAPE)
+    for ti, peak in ((15.0, 137.0), (30.0, 96.3), (60.0, 3.51)):
+        t = math.radians(ti)
+        assert float(m.bridf(t, t, math.pi)) == pytest.approx(peak, rel=0.01), ti
+    # the hand-chosen set of earlier versions still works and says what it is
+    rep = rb08.fig3(rb08.PLAUSIBLE)
+    assert np.all(np.isfinite(rep.tables["curves"].column("brdf_theta_i_60")))
+    assert "plausible" in rep.figure.axes[0].get_title()
+    rep.figure.clear()
+
+
+def test_rb08_fig3_with_the_measured_gray_tape(rbr, shared_data):
+    from roughbrdf.reproduce import rb08
+
+    rep = rb08.fig3(data_dir=shared_data)
+    peaks = rep.tables["retro_peaks"]
+    # ../shared/data/README.md: retro peaks (BRDF cos) 72.5, 42.5, 1.13 -> BRDF = value / cos
+    for row, (ti, brdf_cos) in zip(peaks.rows, ((15, 72.5), (30, 42.5), (60, 1.13)),
+                                   strict=True):
+        assert row[0] == ti and row[1] == pytest.approx(-ti, abs=0.6)
+        assert row[2] == pytest.approx(brdf_cos / math.cos(math.radians(ti)), rel=0.02)
+        assert row[3] > row[2]  # the fit overshoots the retro peak (docs/fitting.md)
+    assert len(rep.figure.axes[0].get_lines()) == 6
+    rep.figure.clear()
+    with pytest.raises(FileNotFoundError, match="gray tape"):
+        rb08.fig3(data_dir=shared_data / "no-such-folder")
 
 
 def test_rb08_figures_labelled(rbr):

@@ -16,6 +16,9 @@ def register(app: typer.Typer) -> None:
         force: Annotated[bool, typer.Option(help="overwrite existing files")] = False,
         compact: Annotated[bool, typer.Option(
             help="256-colour palette PNGs (smaller files)")] = False,
+        data: Annotated[Path | None, typer.Option(
+            help="folder of real measurements (../shared/data): overlay the CEA gray tape on "
+                 "RB08 Fig. 3")] = None,
     ) -> None:
         """Reproduce the figures and tables of TS67, TR75 and RB08 into OUT.
 
@@ -28,8 +31,9 @@ def register(app: typer.Typer) -> None:
         from .. import reproduce
 
         try:
-            paths = reproduce.run(paper, out, force=force, compact=compact, echo=typer.echo)
-        except (ValueError, FileExistsError, reproduce.Unavailable) as exc:
+            paths = reproduce.run(paper, out, force=force, compact=compact, data_dir=data,
+                                   echo=typer.echo)
+        except (ValueError, FileExistsError, FileNotFoundError, reproduce.Unavailable) as exc:
             typer.echo(f"error: {exc}", err=True)
             raise typer.Exit(2) from exc
         typer.echo(f"{len(paths)} files written to {out}")

@@ -21,6 +21,7 @@ puts each figure next to the paper's claim.
 from __future__ import annotations
 
 import importlib
+import inspect
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
@@ -40,10 +41,13 @@ def _functions(paper: str) -> tuple[Callable[[], Reproduction], ...]:
     return tuple(mod.ALL)
 
 
-def reproductions(paper: str = "all", *, skip_unavailable: bool | None = None,
+def reproductions(paper: str = "all", *, data_dir: str | Path | None = None,
+                  skip_unavailable: bool | None = None,
                   echo: Callable[[str], None] | None = None) -> Iterable[Reproduction]:
     """Yield the reproductions of one paper (``"ts67"``, ``"tr75"``, ``"rb08"``) or ``"all"``.
 
+    ``data_dir`` is the folder of real measurements (``../shared/data``); reproductions that can
+    overlay measured points (RB08 Fig. 3: the CEA gray tape) use it, the others ignore it.
     A reproduction that needs a missing part of the library raises :class:`Unavailable`; with
     ``skip_unavailable`` (default: only for ``"all"``) it is skipped and reported to ``echo``.
     """
@@ -52,8 +56,11 @@ def reproductions(paper: str = "all", *, skip_unavailable: bool | None = None,
     papers = list(PAPERS) if every else [paper]
     for p in papers:
         for fn in _functions(p):
+            kwargs = {}
+            if data_dir is not None and "data_dir" in inspect.signature(fn).parameters:
+                kwargs["data_dir"] = data_dir
             try:
-                rep = fn()
+                rep = fn(**kwargs)
             except Unavailable as exc:
                 if not skip:
                     raise
@@ -64,15 +71,17 @@ def reproductions(paper: str = "all", *, skip_unavailable: bool | None = None,
 
 
 def run(paper: str, out: str | Path, *, force: bool = False, compact: bool = False,
+        data_dir: str | Path | None = None,
         echo: Callable[[str], None] | None = None) -> list[Path]:
     """Write the reproductions of ``paper`` (or ``"all"``) into ``out``; return the paths.
 
     Existing files are never overwritten unless ``force``; the check is done per reproduction
-    before anything of it is written. ``compact`` writes palette PNGs (smaller, for committing).
+    before anything of it is written. ``compact`` writes palette PNGs (smaller, for committing);
+    ``data_dir`` is passed to :func:`reproductions`.
     """
     out = Path(out)
     written: list[Path] = []
-    for rep in reproductions(paper, echo=echo):
+    for rep in reproductions(paper, data_dir=data_dir, echo=echo):
         check_writable(rep.outputs(out), force)
         paths = rep.write(out, force=force, compact=compact)
         if rep.figure is not None:

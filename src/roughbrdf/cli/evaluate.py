@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from typing import Annotated
 
 import numpy as np
 import typer
@@ -22,13 +23,18 @@ def register(app: typer.Typer) -> None:
 
     @app.command("eval")
     def eval_cmd(
-        model: str = typer.Argument(..., help="model name, e.g. trowbridge-reitz-1975"),
-        param: list[str] = typer.Option(None, "-p", "--param", help="name=value (repeatable)"),
-        theta_i: str = typer.Option("0", "--theta-i", help="incidence zenith, DEG or A:B:STEP"),
-        theta_r: str = typer.Option("0:90:10", "--theta-r", help="reflection zenith, DEG or A:B:STEP"),
-        phi: str = typer.Option("0", "--phi", help="azimuth (0 = forward), DEG or A:B:STEP"),
-        polarization: str = typer.Option("unpolarized", help="unpolarized, s, p or gamma in DEG"),
-        quantity: str = typer.Option("brdf", help="brdf or bridf"),
+        model: Annotated[str, typer.Argument(help="model name, e.g. trowbridge-reitz-1975")],
+        param: Annotated[list[str] | None, typer.Option(
+            "-p", "--param", help="name=value (repeatable)")] = None,
+        theta_i: Annotated[str, typer.Option(
+            "--theta-i", help="incidence zenith, DEG or START:STOP:STEP")] = "0",
+        theta_r: Annotated[str, typer.Option(
+            "--theta-r", help="reflection zenith, DEG or START:STOP:STEP")] = "0:90:10",
+        phi: Annotated[str, typer.Option(
+            "--phi", help="azimuth (0 = forward), DEG or START:STOP:STEP")] = "0",
+        polarization: Annotated[str, typer.Option(
+            help="unpolarized, s, p or gamma in DEG")] = "unpolarized",
+        quantity: Annotated[str, typer.Option(help="brdf or bridf")] = "brdf",
     ) -> None:
         """Evaluate a model on a grid of angles (degrees) and print CSV."""
         try:

@@ -231,7 +231,7 @@ def sincos(x):
     NaN. Branch-free: the quadrant is selected with comparisons on a float, never an int cast
     (NaN-safe).
     """
-    k = math.floor(x * _INVPIO2 + 0.5)
+    k = np.floor(x * _INVPIO2 + 0.5)  # np.floor: NaN-safe also as plain Python
     r = ((x - k * _PIO2_1) - k * _PIO2_2) - k * _PIO2_3
     z = r * r
     s = r + r * z * (_S1 + z * (_S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))))
@@ -239,7 +239,7 @@ def sincos(x):
     w = 1.0 - hz
     c = w + (((1.0 - w) - hz)
              + z * z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6))))))
-    q = k - 4.0 * math.floor(0.25 * k)  # quadrant 0..3, as a float
+    q = k - 4.0 * np.floor(0.25 * k)  # quadrant 0..3, as a float
     odd = q == 1.0 or q == 3.0
     a = c if odd else s
     b = s if odd else c

@@ -133,8 +133,8 @@ def peak(code, c, a):
     c = min(1.0, max(0.0, c))
     s2 = 1.0 - c * c
     if code == TR:
-        q = a * a * c * c + s2
-        return a ** 4 / (q * q)
+        r = a * a / (a * a * c * c + s2)  # e^4/q^2 as (e^2/q)^2: exactly 1 at c = 1
+        return r * r
     if code == BERRY:
         return a * a / (a * a * c * c + s2)
     if code == GAUSS_ANGLE:

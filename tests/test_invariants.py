@@ -110,8 +110,13 @@ def test_phi_symmetry(model, geo):
 def test_periodic_in_phi(model, geo):
     ti, tr, ph = geo
     ti = _clip_ti(model, ti)
-    np.testing.assert_allclose(model.bridf(ti, tr, ph + 2 * math.pi), model.bridf(ti, tr, ph),
-                               rtol=1e-9, atol=1e-300)
+    # phi + 2 pi is phi only to ~1e-15 rad; near the forward grazing pair (w_i ~ -w_r, where
+    # the half vector turns fast) that rounding is amplified, so keep |w_i + w_r| > 1e-2 there
+    wi, wr = rb.geometry.unit_vectors(ti, tr, ph)
+    ok = np.linalg.norm(wi + wr, axis=-1) > 1e-2
+    a = model.bridf(ti, tr, ph + 2 * math.pi)
+    b = model.bridf(ti, tr, ph)
+    np.testing.assert_allclose(a[ok], b[ok], rtol=1e-9, atol=1e-300)
 
 
 @settings(max_examples=5, deadline=None)

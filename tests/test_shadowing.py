@@ -53,7 +53,8 @@ def test_table_i_equals_closed_form_in_plane_and_edges():
 @given(ti=st.floats(0, HALF_PI), tr=st.floats(0, HALF_PI), ph=st.floats(-np.pi, np.pi))
 def test_table_i_equals_closed_form_property(ti, tr, ph):
     # (w_i = -w_r, theta_i = theta_r = 90 deg at phi = 0, has no half vector: see above)
-    assume(not (ti == tr == HALF_PI and math.cos(ph) > 0.5))
+    # (cosines below 1e-15 count as exactly grazing in the kernels)
+    assume(not (math.cos(ti) < 1e-15 and math.cos(tr) < 1e-15 and math.cos(ph) > 0.5))
     assert S.v_groove_table(ti, tr, ph) == pytest.approx(S.v_groove(ti, tr, ph), abs=1e-10)
 
 

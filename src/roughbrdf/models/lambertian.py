@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import math
 
-from .._jit import jit
+from numba import prange
+
+from .._jit import at, driver, jit
 from .base import Model, register, unit_interval
 
 
@@ -13,6 +15,13 @@ def _lambert_point(ti, tr, phi, gamma, p, flag):
     if flag:
         return p[0] / math.pi * max(0.0, math.cos(tr))  # BRIDF = rho cos(theta_r)/pi
     return p[0] / math.pi
+
+
+@driver
+def _lambert_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
+    # module-level loop: cached on disk (roughbrdf._jit.driver), unlike the generic driver
+    for i in prange(out.size):
+        out[i] = _lambert_point(at(a, i), at(b, i), at(c, i), at(g, i), p, flag)
 
 
 @register
@@ -34,6 +43,7 @@ class Lambertian(Model):
     PARAMETERS = (unit_interval("rho", 0.5, "directional-hemispherical reflectance"),)
     grazing_incidence = True
     _point = _lambert_point
+    _drive = _lambert_drive
 
     def _pack(self) -> tuple:
         return (self._values["rho"],)

@@ -16,9 +16,11 @@ from __future__ import annotations
 
 import math
 
+from numba import prange
+
 from .. import distributions as dist
 from .. import shadowing as shd
-from .._jit import jit
+from .._jit import at, driver, jit
 from ..fresnel import check_index, fresnel_polarized
 from ..geometry import half_vector, tr75_eta_from_h
 from .base import Model, Parameter, nonnegative, positive, register
@@ -50,6 +52,13 @@ def _micro_point(ti, tr, phi, gamma, p, flag):
     return 0.25 * t * geo if t > 0.0 else 0.0
 
 
+@driver
+def _micro_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
+    # module-level loop: cached on disk (roughbrdf._jit.driver), unlike the generic driver
+    for i in prange(out.size):
+        out[i] = _micro_point(at(a, i), at(b, i), at(c, i), at(g, i), p, flag)
+
+
 @register
 class Microfacet(Model):
     """Microfacet BRDF with distribution, shadowing and Fresnel chosen by name.
@@ -76,6 +85,7 @@ class Microfacet(Model):
     )
     OPTIONS = {"distribution": "trowbridge-reitz", "shadowing": "smith-height-correlated"}
     _point = _micro_point
+    _drive = _micro_drive
 
     def _check_options(self, options):
         d = dist.get(options["distribution"])

@@ -21,10 +21,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import prange
 from numpy.typing import ArrayLike
 
 from .. import distributions as dist
-from .._jit import jit
+from .._jit import at, driver, jit
 from ..fresnel import check_index, fresnel_polarized
 from ..geometry import half_vector, tr75_eta_from_h
 from ..shadowing import v_groove_g_over_cos_cos, v_groove_g_over_cos_r
@@ -50,6 +51,13 @@ def _ts67_point(ti, tr, phi, gamma, p, flag):
     # where cos(theta_i) rounds to 0; t = 0 (gaussian underflow) gives 0, never 0 * inf
     geo = v_groove_g_over_cos_cos(ci, cr, hz, cd)
     return rho_d / math.pi * ((t * geo if t > 0.0 else 0.0) + 1.0)
+
+
+@driver
+def _ts67_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
+    # module-level loop: cached on disk (roughbrdf._jit.driver), unlike the generic driver
+    for i in prange(out.size):
+        out[i] = _ts67_point(at(a, i), at(b, i), at(c, i), at(g, i), p, flag)
 
 
 @register
@@ -112,6 +120,7 @@ class TorranceSparrow1967(Model):
                 v["rho_d"], 1.0 if use_f else 0.0)
 
     _point = _ts67_point
+    _drive = _ts67_drive
 
     def relative(self, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
                  polarization=None) -> np.ndarray | float:

@@ -134,7 +134,7 @@ _install_cache_locators()
 _FASTMATH = {"contract"}
 
 
-def jit(fn: Callable | None = None, *, inline: bool = False) -> Callable:
+def jit(fn: Callable | None = None, *, inline: bool = False, contract: bool = True) -> Callable:
     """Compile a scalar physics part with Numba (``cache=True``, IEEE error model).
 
     ``error_model="numpy"`` makes a float division by zero give ``inf``/``nan`` as in NumPy
@@ -145,12 +145,16 @@ def jit(fn: Callable | None = None, *, inline: bool = False) -> Callable:
     parts on the hot path of a model with a :func:`driver` use it: LLVM does not inline them by
     itself (they are compiled as separate libraries and exceed its inlining threshold), and a
     loop that still calls a function is not vectorized. It costs compile time in every caller,
-    so the other parts do not use it.
+    so the other parts do not use it. Inlined parts also get FMA contraction (``_FASTMATH``)
+    unless ``contract=False``: :func:`roughbrdf.fresnel.fresnel_sp` keeps plain rounding,
+    because the RB08 kernel's tests compare its ``1 - R`` near grazing, where ``R`` is 1 to
+    the last bit, with a NumPy reference.
     """
     if fn is None:
-        return lambda f: jit(f, inline=inline)
+        return lambda f: jit(f, inline=inline, contract=contract)
     if inline:
-        return njit(cache=True, error_model="numpy", forceinline=True, fastmath=_FASTMATH)(fn)
+        fm = _FASTMATH if contract else False
+        return njit(cache=True, error_model="numpy", forceinline=True, fastmath=fm)(fn)
     return njit(cache=True, error_model="numpy")(fn)
 
 

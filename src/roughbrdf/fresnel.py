@@ -38,7 +38,7 @@ __all__ = ["fresnel_sp", "fresnel_polarized", "fresnel_polarized_cs", "fresnel_p
            "polarization_angle", "check_index"]
 
 
-@jit(inline=True)
+@jit(inline=True, contract=False)  # plain rounding: see roughbrdf._jit.jit
 def fresnel_sp(c, n, k):
     """Scalar part: ``(R_s, R_p)`` at ``cos t = c`` for index ``n + i k`` (MODELS.md §1.4)."""
     s2 = 1.0 - c * c

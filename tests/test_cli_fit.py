@@ -126,3 +126,27 @@ def test_never_overwrites_foreign_files(tmp_path):
     assert res.exit_code == 0, res.output
     assert (out / "notes.txt").read_text() == "keep"
     assert json.loads((out / "fit.json").read_text())["model"] == "trowbridge-reitz-1975"
+
+
+def test_aperture_option_recorded_in_json_and_report(tmp_path):
+    out = tmp_path / "ap"
+    res = _fit(DEFAULT, "--model", "trowbridge-reitz-1975", "--starts", "1", "--aperture", "2",
+               "--out", out, "--no-plots")
+    assert res.exit_code == 0, res.output
+    assert "aperture           = 2 deg half-angle, uniform cone about w_r" in res.output
+    d = json.loads((out / "fit.json").read_text())
+    assert d["aperture"]["half_angle_deg"] == pytest.approx(2.0)
+    assert d["aperture"]["half_angle_rad"] == pytest.approx(math.radians(2.0))
+    assert d["aperture"]["points"] == 19
+    assert d["options"]["aperture"] == pytest.approx(math.radians(2.0))
+    plain = _fit(DEFAULT, "--model", "trowbridge-reitz-1975", "--starts", "1", "--out",
+                 tmp_path / "plain", "--no-plots", "-q")
+    assert plain.exit_code == 0, plain.output
+    assert json.loads((tmp_path / "plain" / "fit.json").read_text())["aperture"] is None
+
+
+@pytest.mark.parametrize("bad", ["-1", "90", "nan"])
+def test_bad_aperture_is_a_clean_error(tmp_path, bad):
+    res = _fit(DEFAULT, "--model", "ts67", "--aperture", bad, "--out", tmp_path / "x")
+    assert res.exit_code == 2
+    assert "--aperture must be a half-angle in degrees" in res.output

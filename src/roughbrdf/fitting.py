@@ -42,6 +42,37 @@ parameter (never a Python loop over samples). The final covariance uses a centra
 Jacobian on all samples. OpenBLAS runs single-threaded during a fit (:class:`_SingleThreadBLAS`).
 ``docs/fitting.md`` has the benchmarks.
 
+Instrument aperture
+-------------------
+A real gonioreflectometer does not measure the BRDF at one direction: its detector (and source)
+see a small cone, which flattens the top of a peak narrower than the cone (the CEA gray tape's
+retro peak). With ``aperture=a`` (radians) the model prediction for each sample is the average of
+the model over a **uniform cone of half-angle** ``a`` (uniform in solid angle, i.e. a spherical
+cap) **about the measured reflection direction** ``w_r``; ``theta_i`` is kept. The cone stands for
+the combined angular response of source and detector (for a peak that depends on the angle
+between ``w_r`` and a fixed direction, a source cone acts like a detector cone of the same size).
+The average is a fixed cubature rule (:func:`aperture_stencil`): the cone axis plus rings, at
+``u = (1 - cos beta)/(1 - cos a)`` (uniform on [0, 1] over the cap) given by Gauss-Radau nodes
+with the node ``u = 0`` (the axis), and equally spaced azimuths on each ring. ``aperture_points``
+chooses the rule:
+
+====  ======================  ==============================================================
+ S    rings x points          exact (to round-off) for polynomials of the direction vector's
+                              components of degree <= (flat-disk limit: degree in the plane)
+====  ======================  ==============================================================
+ 7    1 x 6 (Radon's rule)    2   (5)
+ 19   2 x 9 (default)         4   (8)
+ 37   3 x 12                  6   (11)
+====  ======================  ==============================================================
+
+so a constant and any quadratic function of direction are averaged exactly by every rule. The
+perturbed angles are built once per fit with NumPy, and the model is evaluated on all ``N x S``
+directions in one call of the compiled kernel, then averaged over ``S`` (the Jacobian uses the
+same path): a fit costs about ``S`` times more. Directions of the cone below the surface are
+clipped to the horizon. ``aperture=None`` or ``0`` is the plain fit, unchanged.
+:func:`aperture_average` gives the same average for any model and geometry, and
+:meth:`FitResult.predict` the fitted model as the fit compared it with the data.
+
 Uncertainties
 -------------
 ``covar = (J^T J)^-1 * chi2/(N - n_varys)``, with ``J`` the Jacobian of the residuals at the optimum
@@ -69,7 +100,8 @@ from .measurement import Measurement
 from .models.base import Model
 from .models.base import model as _make_model
 
-__all__ = ["fit", "FitResult", "ChannelFit", "LOSSES"]
+__all__ = ["fit", "FitResult", "ChannelFit", "LOSSES", "APERTURE_POINTS",
+           "aperture_stencil", "aperture_average"]
 
 #: residual definitions accepted by :func:`fit`
 LOSSES = ("relative", "log", "absolute")
@@ -152,6 +184,129 @@ class _SingleThreadBLAS:
 
 
 # ---------------------------------------------------------------------------------------------
+# instrument aperture: cubature over a uniform cone of directions
+# ---------------------------------------------------------------------------------------------
+#: stencil sizes accepted by ``aperture_points`` -> (rings, points per ring)
+APERTURE_POINTS = {7: (1, 6), 19: (2, 9), 37: (3, 12)}
+
+
+def _radau01(m: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Radau rule on [0, 1] with the node 0 and ``m`` interior nodes (exact to degree 2m)."""
+    from numpy.polynomial import legendre as leg
+
+    # on [-1, 1] with the node -1: the other nodes are the roots of (P_m + P_{m+1})/(1 + x)
+    c = np.zeros(m + 2)
+    c[m] = c[m + 1] = 1.0
+    q, _ = np.polynomial.polynomial.polydiv(leg.leg2poly(c), [1.0, 1.0])
+    x = np.sort(np.real(np.polynomial.polynomial.polyroots(q)))
+    u = np.concatenate([[0.0], 0.5 * (x + 1.0)])
+    # weights from the moments int_0^1 u^k du = 1/(k+1), k = 0..m (the rule is then exact to 2m)
+    vander = np.vander(u, m + 1, increasing=True).T
+    w = np.linalg.solve(vander, 1.0 / np.arange(1, m + 2))
+    return u, w
+
+
+def aperture_stencil(aperture: float, points: int = 19
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Cubature rule for the average over a uniform cone of half-angle ``aperture`` (radians).
+
+    Returns ``(beta, psi, weight)``, each of shape ``(points,)``: the polar angle of each node
+    from the cone axis, its azimuth about the axis, and weights summing to 1. The nodes are the
+    axis plus ``rings`` rings (``APERTURE_POINTS``) at Gauss-Radau values of
+    ``u = (1 - cos beta)/(1 - cos aperture)``; see the module notes for the accuracy.
+    """
+    if points not in APERTURE_POINTS:
+        raise ValueError(f"aperture_points must be one of {sorted(APERTURE_POINTS)}, "
+                         f"got {points!r}")
+    rings, per = APERTURE_POINTS[points]
+    u, wu = _radau01(rings)
+    one_minus_cos = 2.0 * math.sin(0.5 * aperture) ** 2  # 1 - cos(a) without cancellation
+    beta = [0.0]
+    psi = [0.0]
+    wt = [wu[0]]
+    for r in range(1, rings + 1):
+        b = math.acos(1.0 - u[r] * one_minus_cos)
+        offset = math.pi / per if r % 2 == 0 else 0.0  # alternate rings are staggered
+        for k in range(per):
+            beta.append(b)
+            psi.append(offset + 2.0 * math.pi * k / per)
+            wt.append(wu[r] / per)
+    return np.array(beta), np.array(psi), np.array(wt)
+
+
+def _aperture_directions(theta_r: np.ndarray, phi: np.ndarray, aperture: float, points: int
+                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(theta_r, phi)`` of the stencil nodes about each reflection direction, shape (N, S),
+    and the weights (S,)."""
+    from . import geometry
+
+    beta, psi, wt = aperture_stencil(aperture, points)
+    tr = np.asarray(theta_r, dtype=float)[:, None]
+    ph = np.asarray(phi, dtype=float)[:, None]
+    zero = np.zeros_like(tr)
+    w_i, w_r = geometry.unit_vectors(zero, tr, ph)  # (N, 1, 3); w_i only for the conversion
+    # orthonormal frame about w_r: d w_r/d theta_r and d w_r/d phi / sin(theta_r); both are
+    # defined at the pole, so the cone is right for theta_r = 0 too
+    e1 = np.stack([np.cos(tr) * np.cos(ph), np.cos(tr) * np.sin(ph), -np.sin(tr)], axis=-1)
+    e2 = np.stack([-np.sin(ph), np.cos(ph), zero], axis=-1)
+    cb, sb = np.cos(beta)[:, None], np.sin(beta)[:, None]
+    cp, sp = np.cos(psi)[:, None], np.sin(psi)[:, None]
+    w = cb * w_r + sb * (cp * e1 + sp * e2)  # (N, S, 3)
+    _, tr_s, ph_s = geometry.angles_from_vectors(np.broadcast_to(w_i, w.shape), w)
+    # Horizon guard: near grazing reflection part of the cone lies below the surface, where no
+    # model is defined (theta_r > 90 deg). Those nodes are clipped to the horizon (theta_r =
+    # 90 deg, same azimuth): BRDF cos theta_r is 0 there for every model, and a model whose
+    # BRDF is infinite at the horizon makes the sample "model_domain" (left out and counted).
+    tr_s = np.minimum(tr_s, 0.5 * math.pi)
+    return tr_s, ph_s, wt
+
+
+def _check_aperture(aperture: Any, points: Any) -> float | None:
+    """The aperture half-angle as a float, or None for no aperture (None or 0)."""
+    if aperture is None:
+        return None
+    try:
+        a = float(aperture)
+    except (TypeError, ValueError):
+        raise ValueError(f"aperture must be None or a half-angle in radians, got "
+                         f"{aperture!r}") from None
+    if not (math.isfinite(a) and 0.0 <= a < 0.5 * math.pi):
+        raise ValueError(f"aperture must be a half-angle in radians with 0 <= aperture < pi/2, "
+                         f"got {aperture!r}")
+    if points not in APERTURE_POINTS:
+        raise ValueError(f"aperture_points must be one of {sorted(APERTURE_POINTS)}, "
+                         f"got {points!r}")
+    return a if a > 0.0 else None
+
+
+def aperture_average(model: Model, theta_i: Any, theta_r: Any, phi: Any,
+                     aperture: float | None, *, points: int = 19, quantity: str = "brdf",
+                     polarization: Any = None) -> np.ndarray | float:
+    """Average of ``model`` over a uniform cone of half-angle ``aperture`` about each ``w_r``.
+
+    What an instrument of that angular response would read; the prediction :func:`fit` compares
+    with the data when given ``aperture``. ``quantity`` is ``"brdf"`` or ``"bridf"`` (BRDF
+    cos theta_r, averaged as such). ``aperture=None`` or 0 gives the model itself.
+    """
+    a = _check_aperture(aperture, points)
+    if quantity not in ("brdf", "bridf"):
+        raise ValueError(f"quantity must be 'brdf' or 'bridf', got {quantity!r}")
+    ti, tr, ph, gam = model._prepare(theta_i, theta_r, phi, polarization)
+    flag = 1 if quantity == "bridf" else 0
+    if a is None:
+        return model._evaluate(ti, tr, ph, gam, flag)
+    ti, tr, ph, gam = np.broadcast_arrays(ti, tr, ph, gam)
+    shape = ti.shape
+    tr_s, ph_s, wt = _aperture_directions(tr.ravel(), ph.ravel(), a, points)
+    ti_s = np.broadcast_to(ti.reshape(-1, 1), tr_s.shape)
+    gam_s = np.broadcast_to(gam.reshape(-1, 1), tr_s.shape)
+    f = np.asarray(model._evaluate(np.ascontiguousarray(ti_s), tr_s, ph_s,
+                                   np.ascontiguousarray(gam_s), flag), dtype=float)
+    out = f.reshape(tr_s.shape) @ wt
+    return float(out[0]) if shape == () else out.reshape(shape)
+
+
+# ---------------------------------------------------------------------------------------------
 # one channel's objective
 # ---------------------------------------------------------------------------------------------
 class _Objective:
@@ -160,9 +315,19 @@ class _Objective:
     def __init__(self, base: Model, free: list[str], lo: np.ndarray, hi: np.ndarray,
                  ti: np.ndarray, tr: np.ndarray, ph: np.ndarray, gamma: np.ndarray,
                  x: np.ndarray, w: np.ndarray | None, flag: int, loss: str, free_scale: bool,
-                 fixed_scale: float = 1.0):
+                 fixed_scale: float = 1.0, stencil: np.ndarray | None = None):
         self.base, self.free, self.lo, self.hi = base, free, lo, hi
-        self.ti, self.tr, self.ph, self.flag = ti, tr, ph, flag
+        self.flag = flag
+        # with an aperture: ti, tr, ph are (N, S) (the stencil's directions about each sample),
+        # flattened here for one kernel call; ``stencil`` holds the S weights
+        self.stencil = stencil
+        if stencil is not None:
+            shape = (x.size, stencil.size)
+            ti, tr, ph = (np.ascontiguousarray(np.broadcast_to(a, shape)).ravel()
+                          for a in (ti, tr, ph))
+            if np.ndim(gamma):
+                gamma = np.ascontiguousarray(np.broadcast_to(gamma[:, None], shape)).ravel()
+        self.ti, self.tr, self.ph = ti, tr, ph
         self.gamma = gamma
         self.x, self.w, self.loss, self.free_scale = x, w, loss, free_scale
         self.fixed_scale = fixed_scale
@@ -178,10 +343,14 @@ class _Objective:
         return self.base.with_values(self.free, [float(t) for t in theta])
 
     def values(self, theta: np.ndarray) -> np.ndarray:
-        """Model values at the samples (one call of the compiled kernel)."""
+        """Model values at the samples (one call of the compiled kernel); with an aperture, the
+        weighted average over the stencil of each sample."""
         self.nfev += 1
-        return np.asarray(self.model_at(theta)._evaluate(self.ti, self.tr, self.ph, self.gamma,
-                                                         self.flag), dtype=float)
+        f = np.asarray(self.model_at(theta)._evaluate(self.ti, self.tr, self.ph, self.gamma,
+                                                      self.flag), dtype=float)
+        if self.stencil is not None:
+            f = f.reshape(self.n, self.stencil.size) @ self.stencil
+        return f
 
     # residuals --------------------------------------------------------------------------------
     def _sum(self, a: np.ndarray) -> float:
@@ -412,6 +581,8 @@ def _fmt(v: float | None, digits: int = 6) -> str:
 class FitResult:
     """Result of :func:`fit`: one :class:`ChannelFit` per fitted channel.
 
+    ``aperture`` / ``aperture_points`` record the instrument aperture the fit used (None: none);
+    :meth:`predict` evaluates the fitted model the way the fit compared it with the data.
     ``res[label]`` or ``res[i]`` gives a channel. For a fit of a single channel, ``model``,
     ``params``, ``stderr``, ``correl``, ``sigma``, ``rms_log`` and ``message`` are that channel's;
     with several channels they raise and point to ``res[...]``. ``success`` is true when every
@@ -426,6 +597,10 @@ class FitResult:
     relative_to: str | None
     options: dict[str, Any]
     elapsed: float
+    #: instrument aperture of the fit (half-angle, radians; None: none) and its stencil size; kept
+    #: so that predictions and plots can average the model the same way (:meth:`predict`)
+    aperture: float | None = None
+    aperture_points: int = 19
 
     # single-channel shortcuts -------------------------------------------------------------------
     def _one(self, what: str) -> ChannelFit:
@@ -482,6 +657,18 @@ class FitResult:
     def __iter__(self):
         return iter(self.channels)
 
+    def predict(self, theta_i: Any, theta_r: Any, phi: Any, *, channel: int | str = 0,
+                polarization: Any = None, aperture: bool = True) -> np.ndarray | float:
+        """The fitted model of ``channel`` as compared with the data: the quantity ``compared``
+        (BRDF or BRDF cos theta_r), averaged over the fit's aperture (``aperture=False``: at the
+        given directions only). On the model's absolute scale; relative data are ``K x``."""
+        c = self[channel] if isinstance(channel, str) else self.channels[channel]
+        q = "bridf" if self.compared in ("bridf", "brdf_cos") else "brdf"
+        return aperture_average(c.model, theta_i, theta_r, phi,
+                                self.aperture if aperture else None,
+                                points=self.aperture_points, quantity=q,
+                                polarization=polarization)
+
     # output ---------------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
         """The ``fit.json`` content (keys ``model``, ``file``, ``loss``, ``channels`` ...)."""
@@ -515,6 +702,12 @@ class FitResult:
             "relative_to": self.relative_to,
             "sample": meta.get("sample"),
             "options": self.options,
+            "aperture": None if self.aperture is None else {
+                "half_angle_rad": self.aperture,
+                "half_angle_deg": math.degrees(self.aperture),
+                "points": self.aperture_points,
+                "convention": "model averaged over a uniform cone (solid angle) of this "
+                              "half-angle about the measured reflection direction"},
             "elapsed_s": self.elapsed,
             "channels": chans,
         })
@@ -540,6 +733,10 @@ class FitResult:
                  f"    data quantity      = {self.measurement.quantity}",
                  f"    compared with      = {comp}",
                  f"    loss               = {loss_txt}",
+                 "    aperture           = " + (
+                     "none (model at each measured direction)" if self.aperture is None else
+                     f"{math.degrees(self.aperture):.4g} deg half-angle, uniform cone about "
+                     f"w_r ({self.aperture_points}-point stencil)"),
                  f"    channels           = {len(self.channels)}",
                  f"    time               = {self.elapsed:.3g} s"]
         for c in self.channels:
@@ -799,7 +996,8 @@ def _where(meas: Measurement, label: str) -> str:
 
 
 def _prepare_channel(model: Model, meas: Measurement, j: int, flag: int, loss: str, weights: Any,
-                     nonfinite: str, negative: str):
+                     nonfinite: str, negative: str, aperture: float | None = None,
+                     aperture_points: int = 19):
     """Select the samples of channel ``j`` that enter the fit; count everything left out."""
     label = meas.channels[j]
     x = meas.values[:, j].astype(float).copy()
@@ -846,13 +1044,15 @@ def _prepare_channel(model: Model, meas: Measurement, j: int, flag: int, loss: s
         excluded["horizon"] = int(horizon.sum())
         keep &= ~horizon
     # samples where the model itself is not finite at the starting values (e.g. the BRDF of the
-    # unshadowed TR75 model at theta_r = 90 deg, which is +inf): these cannot be fitted
+    # unshadowed TR75 model at theta_r = 90 deg, which is +inf): these cannot be fitted. With
+    # an aperture, the model averaged over the cone (as the fit will compare it) is checked.
     idx = np.flatnonzero(keep)
     if idx.size:
         gam = (np.asarray(np.nan) if meas.polarization is None
                else np.ascontiguousarray(meas.polarization[idx]))
-        f0 = np.asarray(model._evaluate(meas.theta_i[idx], meas.theta_r[idx], meas.phi[idx],
-                                        gam, flag), dtype=float)
+        geo, stencil = _geometry(meas, idx, aperture, aperture_points)
+        f0 = _Objective(model, [], np.empty(0), np.empty(0), *geo, gam, x[idx], None, flag,
+                        "absolute", False, 1.0, stencil).values(np.empty(0))
         ok = np.isfinite(f0)
         if not ok.all():
             excluded["model_domain"] += int((~ok).sum())
@@ -897,7 +1097,8 @@ def fit(model: Model | str, measurement: Measurement, *,
         relative_to: str | None = None, free_scale: bool | None = None,
         scale: float | None = None,
         screen: int = 64, subsample: int | None = 1000, polish: int = 2,
-        max_nfev: int | None = None,
+        max_nfev: int | None = None, aperture: float | None = None,
+        aperture_points: int = 19,
         progress: bool | None = None) -> FitResult:
     """Fit ``model`` to ``measurement``, each channel on its own.
 
@@ -952,6 +1153,14 @@ def fit(model: Model | str, measurement: Measurement, *,
         Number of explored end points refined on the full data.
     max_nfev : int, optional
         Limit of function evaluations per local fit (``least_squares``).
+    aperture : float or None
+        Instrument angular response: half-angle (radians) of a uniform cone about the measured
+        reflection direction. Each sample is compared with the model averaged over that cone
+        (see the module notes, "Instrument aperture"); ``None`` or 0: the model at the sample's
+        direction. Must satisfy ``0 <= aperture < pi/2``.
+    aperture_points : {7, 19, 37}
+        Size of the cubature rule over the cone (:func:`aperture_stencil`); the fit costs about
+        that many times more model evaluations.
     progress : bool or None
         Show a tqdm progress bar; ``None`` shows it only on an interactive terminal.
 
@@ -964,7 +1173,7 @@ def fit(model: Model | str, measurement: Measurement, *,
     ValueError
         Unknown loss or option, every parameter fixed, no data left in a channel, non-finite
         values with ``nonfinite="raise"``, non-positive values for the log loss with
-        ``negative="keep"``.
+        ``negative="keep"``, an aperture that is negative, not finite or >= pi/2.
     """
     t_start = time.perf_counter()
     if isinstance(model, str):
@@ -983,6 +1192,7 @@ def fit(model: Model | str, measurement: Measurement, *,
     if starts < 1:
         raise ValueError(f"starts must be >= 1, got {starts}")
     polish = max(1, int(polish))
+    ap = _check_aperture(aperture, aperture_points)
     meas = measurement
     flag, compared, rel = _resolve_quantity(meas, relative_to)
     if scale is not None:
@@ -1011,8 +1221,8 @@ def fit(model: Model | str, measurement: Measurement, *,
     sobol_x = lo + sobol * (hi - lo)
 
     # prepare every channel first, so that bad input fails before any work
-    prepared = [_prepare_channel(model, meas, j, flag, loss, weights, nonfinite, negative)
-                for j in chans]
+    prepared = [_prepare_channel(model, meas, j, flag, loss, weights, nonfinite, negative, ap,
+                                 aperture_points) for j in chans]
     n_varys = len(free) + (1 if free_scale else 0)
     for j, (idx, _, _, _) in zip(chans, prepared, strict=True):
         if idx.size <= n_varys:
@@ -1038,16 +1248,15 @@ def fit(model: Model | str, measurement: Measurement, *,
                 pbar.set_postfix_str(label)
             gam = (np.asarray(np.nan) if meas.polarization is None
                    else np.ascontiguousarray(meas.polarization[idx]))
-            geo = (np.ascontiguousarray(meas.theta_i[idx]), np.ascontiguousarray(meas.theta_r[idx]),
-                   np.ascontiguousarray(meas.phi[idx]))
+            geo, stencil = _geometry(meas, idx, ap, aperture_points)
             full = _Objective(model, free, lo, hi, *geo, gam, x, w, flag, loss, free_scale,
-                              fixed_scale)
+                              fixed_scale, stencil)
             if subsample is not None and idx.size > subsample:
                 sub = np.sort(rng.choice(idx.size, size=int(subsample), replace=False))
                 explore = _Objective(model, free, lo, hi, *(g[sub] for g in geo),
                                      gam if gam.ndim == 0 else gam[sub], x[sub],
                                      None if w is None else w[sub], flag, loss, free_scale,
-                                     fixed_scale)
+                                     fixed_scale, stencil)
             else:
                 explore = full
             points = [x0] + ([warm] if warm is not None else []) + _screen(
@@ -1098,10 +1307,27 @@ def fit(model: Model | str, measurement: Measurement, *,
                               "polish": polish, "nonfinite": nonfinite, "negative": negative,
                               "free_scale": bool(free_scale),
                               "scale": scale,
+                              "aperture": ap,
+                              "aperture_points": aperture_points if ap is not None else None,
                               "fix": sorted(set(model.param_names) - set(free)),
                               "weights": None if weights is None else
                               (weights if isinstance(weights, str) else "array")},
-                     elapsed=time.perf_counter() - t_start)
+                     elapsed=time.perf_counter() - t_start, aperture=ap,
+                     aperture_points=int(aperture_points))
+
+
+def _geometry(meas: Measurement, idx: np.ndarray, aperture: float | None, points: int
+              ) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray | None]:
+    """``(theta_i, theta_r, phi)`` of the fitted samples, and the stencil weights: without an
+    aperture each array is (N,) and the weights None; with one, ``theta_i`` is (N, 1) and
+    ``theta_r``, ``phi`` are (N, S), the stencil's directions about each sample (built once)."""
+    ti = np.ascontiguousarray(meas.theta_i[idx])
+    tr = np.ascontiguousarray(meas.theta_r[idx])
+    ph = np.ascontiguousarray(meas.phi[idx])
+    if aperture is None:
+        return (ti, tr, ph), None
+    tr_s, ph_s, wt = _aperture_directions(tr, ph, aperture, points)
+    return (ti[:, None], tr_s, ph_s), wt
 
 
 def _finish(model: Model, obj: _Objective, theta: np.ndarray, res: Any, label: str,

@@ -2,14 +2,18 @@
 
 Writes ``fit.json`` (keys ``model``, ``file``, ``loss``, ``channels``: per channel ``channel``,
 ``params``, ``stderr``, ``success``, ``metrics`` with ``sigma``, ``rms_log``, ``chi2``, ``aic``,
-``bic``, ``n_points``; more keys may follow), ``report.txt`` and one ``fit_<channel>.png`` per
-channel into DIR. DIR may exist: files roughbrdf wrote there before are replaced, any other file
+``bic``, ``n_points``; more keys may follow; ``aperture``: null or the instrument aperture used,
+``half_angle_deg``, ``half_angle_rad``, ``points``), ``report.txt`` and one ``fit_<channel>.png``
+per channel into DIR. ``--aperture DEG`` compares each sample with the model averaged over a uniform
+cone of that half-angle (degrees) about the measured reflection direction (``rb.fit(...,
+aperture=radians)``). DIR may exist: files roughbrdf wrote there before are replaced, any other file
 of the same name is left alone and the command stops (``--force`` overrides); see
 :mod:`roughbrdf._outdir`.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Annotated, Any
 
 import typer
@@ -105,6 +109,10 @@ def register(app: typer.Typer) -> None:
         nonfinite: str = typer.Option("raise", help="non-finite values: raise or drop"),
         negative: str = typer.Option("keep", help="negative values: keep, drop or clip"),
         seed: int = typer.Option(0, help="seed of the Sobol starts and the subsample"),
+        aperture: float = typer.Option(None, "--aperture", metavar="DEG",
+                                       help="instrument aperture: half-angle in degrees of a "
+                                            "uniform cone about the reflection direction; the "
+                                            "model is averaged over it (default: none)"),
         plots: bool = typer.Option(True, "--plots/--no-plots", help="write PNG plots"),
         force: bool = typer.Option(False, "--force",
                                    help="overwrite files of the same name not written by "
@@ -116,6 +124,9 @@ def register(app: typer.Typer) -> None:
         from ..fitting import fit
 
         try:
+            if aperture is not None and not (math.isfinite(aperture) and 0 <= aperture < 90):
+                raise ValueError(f"--aperture must be a half-angle in degrees, 0 <= DEG < 90; "
+                                 f"got {aperture!r}")
             m = build_model(model, parse_params(param))
             fixed = resolve_names(m, list(fix or []))
             opts: dict[str, Any] = {}
@@ -127,6 +138,7 @@ def register(app: typer.Typer) -> None:
             res = fit(m, meas, channel=list(channel) if channel else None, loss=loss, fix=fixed,
                       starts=starts, seed=seed,
                       nonfinite=nonfinite, negative=negative, relative_to=relative_to,
+                      aperture=None if aperture is None else math.radians(aperture),
                       progress=None if not quiet else False)
             written = res.save(out, plots=plots, force=force)
         except (ValueError, FileNotFoundError, FileExistsError, TypeError) as exc:

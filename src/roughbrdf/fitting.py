@@ -509,7 +509,8 @@ class ChannelFit:
     data : numpy.ndarray
         The fitted values (after ``negative="clip"``), in the measurement's own scale.
     fitted : numpy.ndarray
-        The model at those samples (the quantity compared).
+        The model at those samples (the quantity compared; averaged over the aperture when the
+        fit had one).
     residual : numpy.ndarray
         The loss residuals at the optimum.
     """
@@ -814,7 +815,10 @@ class FitResult:
         """Data vs model (in-plane slices per incidence) and the residual map of one channel.
 
         Uses :func:`roughbrdf.plot.plot_comparison` and :func:`roughbrdf.plot.plot_residual_map`;
-        returns ``(fig, (ax_comparison, ax_residuals))``.
+        returns ``(fig, (ax_comparison, ax_residuals))``. Both draw the fitted model at each
+        direction, not averaged over the fit's aperture (the plot module does not know it yet;
+        ``self.aperture`` and :meth:`predict` are there for it): with an aperture, a sharp peak
+        shows above the data it was fitted to.
         """
         import matplotlib.pyplot as plt
 

@@ -39,6 +39,8 @@ def tr75_eq20_21(s: float, n: float, k: float) -> tuple[float, float]:
     a = n * sin_s / m2
     b = k * sin_s / m2
     c = 1 - sin_s**2 / m2
+    if k == 0 and c <= 0:  # beyond the critical angle: sin s1 = 1 exactly, and Eq. 20-21 give 1
+        return 1.0, 1.0  # (evaluating asin at a rounded 1 - 1e-16 would lose 8 digits)
     root = math.sqrt(c * c + 4 * b * b)
     # (root - c)/2, written without cancellation when c > 0 (small s, where root ~ c)
     sinh2 = 2 * b * b / (root + c) if c > 0 else (root - c) / 2

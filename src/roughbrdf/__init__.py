@@ -21,6 +21,7 @@ from . import distributions, fresnel, geometry, shadowing  # noqa: E402
 from .fitting import FitResult, fit
 from .integrate import albedo, reciprocity_error
 from .io import read, write
+from .measurement import Measurement
 from .models import Model, Parameter, SumModel, available, model
 
 __version__ = "0.1.0"
@@ -33,6 +34,7 @@ __all__ = [
     "FitResult",
     "fresnel",
     "geometry",
+    "Measurement",
     "model",
     "Model",
     "Parameter",

@@ -19,8 +19,13 @@ Needs ``../shared/data`` (or ``ROUGHBRDF_SHARED_DATA``); prints a note and retur
    absolute form with F = 1 and g up to 2000; microfacet Trowbridge-Reitz + Smith + Fresnel +
    Lambertian). Printed as Markdown for ``docs/fitting.md``.
 4. **RB08** on the CEA retro-reflector files (log loss, samples within 2 deg of the retro
-   direction weighted x20): retro peak heights, model vs measured, per incidence. With ``--docs``
-   the fit plots are saved as ``docs/img/rb08_<file>.png``.
+   direction weighted x20), without and with the instrument aperture (``rb.fit(...,
+   aperture=...)``, ``APERTURE_DEG`` half-angle; the aperture fit starts from the plain fit):
+   retro peak heights, measured vs the model as the instrument would read it (averaged over the
+   aperture), per incidence. With ``--scan`` the fit cost is also tabulated against the aperture
+   (on the test subset of ``tests/test_fitting_real.py``), which is how ``APERTURE_DEG`` was
+   chosen. With ``--docs`` the fit plots are saved as ``docs/img/rb08_<file>.png``, with the
+   aperture-averaged model drawn over the plain curves.
 """
 
 from __future__ import annotations
@@ -35,6 +40,7 @@ from scipy.optimize import least_squares
 from scipy.stats import qmc
 
 import roughbrdf as rb
+from roughbrdf import geometry
 from roughbrdf.fitting import _SingleThreadBLAS
 
 HERE = Path(__file__).resolve().parent
@@ -234,43 +240,143 @@ def retro_distance_deg(meas) -> np.ndarray:
     return np.degrees(np.arccos(np.clip(dot, -1.0, 1.0)))
 
 
-def rb08_cea(docs: bool = False) -> None:
+#: instrument aperture (half-angle, deg) of the CEA gonio-reflectometer: the minimum over
+#: SCAN_DEG of the gray tape's fit cost (its retro peak is the sharpest); see ``--scan``
+APERTURE_DEG = 1.0
+SCAN_DEG = (0.5, 0.75, 1.0, 1.25, 1.5, 2.0)
+RETRO_FILES = ("retro-gray-tape.dat", "retro-3M-jaune.dat")
+
+
+def retro_weights(meas) -> np.ndarray:
+    """x20 within 2 deg of the retro direction: the peak is a few dozen of ~7400 samples."""
+    return np.where(retro_distance_deg(meas) <= 2.0, 20.0, 1.0)
+
+
+def retro_peak_text(meas, res) -> tuple[str, str]:
+    """Per incidence: 'measured -> model (rel.)' with the model averaged over the fit's
+    aperture (what the instrument reads), and the model's own value at the retro point."""
+    d = retro_distance_deg(meas)
+    peaks, raw = [], []
+    for ti in meas.incidences(4):
+        sel = (np.abs(meas.theta_i - ti) < 1e-3) & (d <= 0.5)
+        measured = float(meas.values[sel, 0].max())
+        model = float(res.predict(float(ti), float(ti), math.pi))
+        peaks.append(f"{measured:.3g} -> {model:.3g} ({model / measured - 1:+.0%})")
+        raw.append(f"{float(res.predict(float(ti), float(ti), math.pi, aperture=False)):.3g}")
+    return " / ".join(peaks), " / ".join(raw)
+
+
+def rb08_scan() -> None:
+    """Fit cost vs aperture on the test subset (every 6th sample + all within 3 deg of retro),
+    each aperture fit starting from the plain fit, as in tests/test_fitting_real.py."""
+    print("### RB08: fit cost vs aperture (test subset; plain fit 8 starts, aperture fits 2 "
+          "starts from it)\n")
+    print("| file | aperture (deg) | weighted chi2 (log loss) | sigma | rms-log | "
+          "retro peak, measured -> model (15 / 30 / 60 deg) | time (s) |")
+    print("|---|---|---|---|---|---|---|")
+    for name in RETRO_FILES:
+        meas = rb.read(DATA / "cea_retro" / name, quantity="brdf_cos")
+        d = retro_distance_deg(meas)
+        keep = (np.arange(meas.n_samples) % 6 == 0) | (d <= 3.0)
+        sub = meas.subset(keep)
+        w = retro_weights(sub)
+        plain = rb.fit(rb.model("renhorn-boreman-2008"), sub, loss="log", weights=w, starts=8,
+                       progress=False)
+        for a in (0.0, *SCAN_DEG):
+            t = time.perf_counter()
+            res = plain if a == 0 else rb.fit(plain.model, sub, loss="log", weights=w,
+                                              starts=2, aperture=math.radians(a),
+                                              progress=False)
+            dt = time.perf_counter() - t
+            c = res.channels[0]
+            peaks, _ = retro_peak_text(sub, res)
+            print(f"| {name} | {a:g} | {c.chi2:.0f} | {c.sigma:.3f} | {c.rms_log:.3f} | "
+                  f"{peaks} | {dt if a else 0:.1f} |")
+    print()
+
+
+def rb08_cea(docs: bool = False, scan: bool = False) -> None:
     if "renhorn-boreman-2008" not in rb.available():
         print("### RB08: model not available\n")
         return
-    print("### RB08 on the CEA retro-reflectors (log loss, x20 weight within 2 deg of retro)\n")
-    print("| file | sigma | rms-log | time (s) | retro peak BRDF cos, measured -> model "
-          "(15 / 30 / 60 deg) |")
-    print("|---|---|---|---|---|")
-    for name in ("retro-gray-tape.dat", "retro-3M-jaune.dat"):
+    if scan:
+        rb08_scan()
+    print("### RB08 on the CEA retro-reflectors (log loss, x20 weight within 2 deg of retro; "
+          f"all samples; plain fit: rb.fit defaults; aperture {APERTURE_DEG:g} deg: 2 starts, "
+          "the first the plain optimum)\n")
+    print("| file | aperture (deg) | sigma | rms-log | time (s) | retro peak BRDF cos, measured "
+          "-> model read through the aperture (15 / 30 / 60 deg) | model at the retro point |")
+    print("|---|---|---|---|---|---|---|")
+    for name in RETRO_FILES:
         meas = rb.read(DATA / "cea_retro" / name, quantity="brdf_cos")
-        d = retro_distance_deg(meas)
-        w = np.where(d <= 2.0, 20.0, 1.0)
+        w = retro_weights(meas)
         t = time.perf_counter()
-        res = rb.fit(rb.model("renhorn-boreman-2008"), meas, loss="log", weights=w,
-                     progress=False)
-        dt = time.perf_counter() - t
-        peaks = []
-        for ti in meas.incidences(4):
-            sel = (np.abs(meas.theta_i - ti) < 1e-3) & (d <= 0.5)
-            measured = float(meas.values[sel, 0].max())
-            model = float(res.model.bridf(float(ti), float(ti), math.pi))
-            peaks.append(f"{measured:.3g} -> {model:.3g} ({model / measured - 1:+.0%})")
-        print(f"| {name} | {res.sigma:.3g} | {res.rms_log:.3f} | {dt:.1f} | "
-              f"{' / '.join(peaks)} |")
+        plain = rb.fit(rb.model("renhorn-boreman-2008"), meas, loss="log", weights=w,
+                       progress=False)
+        t_plain = time.perf_counter() - t
+        t = time.perf_counter()
+        res = rb.fit(plain.model, meas, loss="log", weights=w, starts=2,
+                     aperture=math.radians(APERTURE_DEG), progress=False)
+        t_ap = time.perf_counter() - t
+        for r, dt in ((plain, t_plain), (res, t_ap)):
+            peaks, raw = retro_peak_text(meas, r)
+            a = "none" if r.aperture is None else f"{math.degrees(r.aperture):g}"
+            print(f"| {name} | {a} | {r.sigma:.3g} | {r.rms_log:.3f} | {dt:.1f} | {peaks} | "
+                  f"{raw} |")
         if docs:
-            import matplotlib
-
-            matplotlib.use("Agg")
-            import matplotlib.pyplot as plt
-
-            fig, _ = res.plot(0)
-            out = HERE.parent / "docs" / "img" / f"rb08_{name.removesuffix('.dat')}.png"
-            out.parent.mkdir(parents=True, exist_ok=True)
-            fig.savefig(out, dpi=90)
-            plt.close(fig)
-            print(f"\nsaved {out.relative_to(HERE.parent)}")
+            save_rb08_plot(name, res)
     print()
+
+
+def save_rb08_plot(name: str, res) -> None:
+    """Left and middle: FitResult.plot's panels (in-plane slices and residual map, drawn with the
+    fitted model at each direction, as roughbrdf.plot does); right: a zoom on the retro peak,
+    in-plane, with the model at each direction (thin) and read through the aperture (thick,
+    what the fit compared with the data)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from roughbrdf import plot as rbplot
+
+    model, meas = res.plot_data(0)
+    fig = plt.figure(figsize=(18, 5.2))
+    ax1 = fig.add_subplot(1, 3, 1)
+    ax2 = fig.add_subplot(1, 3, 2)
+    ax3 = fig.add_subplot(1, 3, 3)
+    rbplot.plot_comparison(model, meas, channel=0, ax=ax1)
+    rbplot.plot_residual_map(model, meas, channel=0, ax=ax2)
+    inplane = meas.in_plane()
+    incs = inplane.incidences(4)
+    off = np.radians(np.linspace(-6.0, 6.0, 1201))  # 0.01 deg: resolves the retro cusp
+    for t, col in zip(incs, rbplot.incidence_colors(len(incs)), strict=True):
+        sel = inplane.at_incidence(float(t), atol=1e-4)
+        x = np.degrees(geometry.signed_angle(sel.theta_r, sel.phi) + t)  # 0 at retro
+        near = np.abs(x) <= 6.0
+        lab = f"{math.degrees(t):.3g}°"
+        ax3.plot(x[near], sel.values[near, 0], "o", ms=4, mfc="none", color=col,
+                 label=rf"data $\theta_i$ = {lab}")
+        tr, ph = geometry.from_signed_angle(off - t)
+        ax3.plot(np.degrees(off), res.predict(float(t), tr, ph, aperture=False), color=col,
+                 lw=0.8, alpha=0.7, label="model")
+        if res.aperture is not None:
+            ax3.plot(np.degrees(off), res.predict(float(t), tr, ph), color=col, lw=2.2,
+                     label="model through the aperture")
+    ax3.set_yscale("log")
+    ax3.set_xlim(-6, 6)
+    ax3.set_xlabel(r"in-plane angle from the retro direction [deg]")
+    ax3.set_ylabel(rbplot.QUANTITY_LABELS["bridf"])
+    ap = "none" if res.aperture is None else f"{math.degrees(res.aperture):g}° half-angle"
+    ax3.set_title(f"retro peak, aperture {ap}", fontsize="medium")
+    ax3.grid(True, alpha=0.3)
+    ax3.legend(fontsize="x-small", ncol=1, loc="upper right")
+    fig.tight_layout()
+    out = HERE.parent / "docs" / "img" / f"rb08_{name.removesuffix('.dat')}.png"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=90)
+    plt.close(fig)
+    print(f"\nsaved {out.relative_to(HERE.parent)}\n")
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -280,10 +386,13 @@ def main(argv: list[str] | None = None) -> None:
     if not (DATA / "minidiff").is_dir():
         print(f"skipped: real data not found at {DATA} (set ROUGHBRDF_SHARED_DATA)")
         return
+    if "--rb08" in args:  # only the RB08 section
+        rb08_cea(docs="--docs" in args, scan="--scan" in args)
+        return
     speed()
     global_optimum()
     table()
-    rb08_cea(docs="--docs" in args)
+    rb08_cea(docs="--docs" in args, scan="--scan" in args)
 
 
 if __name__ == "__main__":

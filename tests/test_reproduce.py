@@ -364,24 +364,40 @@ def test_rb08_fig3_two_orders_of_magnitude(rbr):
     for c in curves.columns[1:]:
         y = curves.column(c)
         assert np.all(np.isfinite(y)) and np.all(y > 0), c
-    # the gray tape is a retro-reflector: each curve peaks at the retro direction -theta_i
+    # the gray tape is a retro-reflector: the 15 and 30 deg curves peak at the retro direction
+    # -theta_i; at 60 deg the fitted Vm (B ~ 330 at zeta = -90 deg) lifts source-side grazing
+    # above the retro peak, so there the retro direction is only a local maximum
     for row in rng.rows[:-1]:
         ti, tmax = row[0], row[3]
-        assert tmax == pytest.approx(-ti, abs=1.0), (ti, tmax)
+        if ti < 60:
+            assert tmax == pytest.approx(-ti, abs=1.0), (ti, tmax)
+        else:
+            assert tmax < -80.0, (ti, tmax)
+    x = curves.column("theta_signed_deg")
+    y60 = curves.column("brdf_theta_i_60")
+    near = np.abs(x + 60.0) <= 5.0
+    assert x[near][np.argmax(y60[near])] == pytest.approx(-60.0, abs=0.5)
     params = dict(rbr["rb08_fig03"].tables["params"].rows)
     assert len(params) == 14
     assert "retro_peaks" not in rbr["rb08_fig03"].tables  # no data overlay by default
 
 
 def test_rb08_gray_tape_parameters_match_the_published_fit(rbr):
-    """rb08.CEA_GRAY_TAPE reproduces docs/fitting.md: model retro peaks (BRDF cos) 137, 96.3
-    and 3.51 at 15, 30 and 60 deg."""
+    """rb08.CEA_GRAY_TAPE with retro_shadowing="amplitude" gives the model retro peaks
+    (BRDF cos) 72.9, 45.1 and 1.25 at 15, 30 and 60 deg, as measured on 2026-11-22 when the set
+    was fitted (recipe of tests/test_fitting_real.py::
+    test_rb08_amplitude_reading_reproduces_retro_peaks_on_all_samples; sigma 0.417, rms-log
+    0.805, see the comment on rb08.CEA_GRAY_TAPE)."""
     from roughbrdf.reproduce import rb08
 
+    assert rb08.CEA_GRAY_TAPE_OPTIONS == {"retro_shadowing": "amplitude"}
     m = rb08.model(rb08.CEA_GRAY_TAPE)
-    for ti, peak in ((15.0, 137.0), (30.0, 96.3), (60.0, 3.51)):
+    assert m.options["retro_shadowing"] == "amplitude"
+    assert rb08.model().options["retro_shadowing"] == "amplitude"  # the figures use it too
+    for ti, peak in ((15.0, 72.9), (30.0, 45.1), (60.0, 1.25)):
         t = math.radians(ti)
         assert float(m.bridf(t, t, math.pi)) == pytest.approx(peak, rel=0.01), ti
+    assert rb08.CEA_GRAY_TAPE["n_eff"] >= 1.0  # no critical angle, no kinks at +-30 deg
     # the hand-chosen set of earlier versions still works and says what it is
     rep = rb08.fig3(rb08.PLAUSIBLE)
     assert np.all(np.isfinite(rep.tables["curves"].column("brdf_theta_i_60")))
@@ -399,7 +415,8 @@ def test_rb08_fig3_with_the_measured_gray_tape(rbr, shared_data):
                                    strict=True):
         assert row[0] == ti and row[1] == pytest.approx(-ti, abs=0.6)
         assert row[2] == pytest.approx(brdf_cos / math.cos(math.radians(ti)), rel=0.02)
-        assert row[3] > row[2]  # the fit overshoots the retro peak (docs/fitting.md)
+        # model within +1/+6/+10 % of the measured retro peak (BRDF cos 72.9/45.1/1.25 model)
+        assert row[3] == pytest.approx(row[2], rel=0.12)
     assert len(rep.figure.axes[0].get_lines()) == 6
     rep.figure.clear()
     with pytest.raises(FileNotFoundError, match="gray tape"):

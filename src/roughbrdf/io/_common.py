@@ -48,6 +48,18 @@ def read_text(path: str | os.PathLike) -> list[str]:
         return fh.read().splitlines()
 
 
+def begin_read(fmt: str, path: str | os.PathLike, options: dict, quantity: str | None = None
+               ) -> tuple[Path, list[str]]:
+    """Shared start of the text readers: reject unknown options and quantities, read the lines."""
+    from ..measurement import QUANTITIES
+
+    if options:
+        raise TypeError(f"{fmt}.read got unknown options {sorted(options)}")
+    if quantity is not None and quantity not in QUANTITIES:
+        raise ValueError(f"quantity must be one of {QUANTITIES}, got {quantity!r}")
+    return Path(path), read_text(path)
+
+
 def _is_number(tok: str) -> bool:
     try:
         float(tok)

@@ -42,7 +42,6 @@ from __future__ import annotations
 import math
 import os
 import shlex
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -54,10 +53,10 @@ from ._common import (
     ZENITH_SLACK,
     FormatError,
     azimuth_rows,
+    begin_read,
     check_zenith_rows,
     common_frame_from_spherical,
     parse_rows,
-    read_text,
 )
 
 __all__ = ["read", "write", "EXTENSIONS", "PARAM_IN"]
@@ -89,12 +88,7 @@ def read(path: str | os.PathLike, *, quantity: str | None = None, **options: Any
         What the values hold when the file has no ``#PARAM_OUT`` (or to state it explicitly;
         it must then agree with the file's declaration).
     """
-    if options:
-        raise TypeError(f"alta.read got unknown options {sorted(options)}")
-    if quantity is not None and quantity not in QUANTITIES:
-        raise ValueError(f"quantity must be one of {QUANTITIES}, got {quantity!r}")
-    path = Path(path)
-    lines = read_text(path)
+    path, lines = begin_read("alta", path, options, quantity)
     header: dict[str, str] = {}
     hline: dict[str, int] = {}
     texts: list[str] = []

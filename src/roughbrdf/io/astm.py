@@ -49,10 +49,10 @@ from ._common import (
     FormatError,
     angle_factor,
     azimuth_rows,
+    begin_read,
     check_zenith_rows,
     common_frame_from_spherical,
     parse_rows,
-    read_text,
 )
 
 __all__ = ["read", "write", "EXTENSIONS"]
@@ -101,10 +101,7 @@ def read(path: str | os.PathLike, *, angles: str | None = None, quantity: str | 
     quantity : str, optional
         Override the quantity (default from ``MEAS_NAME``).
     """
-    if options:
-        raise TypeError(f"astm.read got unknown options {sorted(options)}")
-    path = Path(path)
-    lines = read_text(path)
+    path, lines = begin_read("astm", path, options, quantity)
     header: dict[str, str] = {}
     header_lines: dict[str, int] = {}
     data_start = None
@@ -231,9 +228,7 @@ def read(path: str | os.PathLike, *, angles: str | None = None, quantity: str | 
 
     # --- quantity, polarization, provenance --------------------------------------------------
     meas_name = header.get("MEAS_NAME", "").strip()
-    if quantity is not None:
-        if quantity not in QUANTITIES:
-            raise ValueError(f"quantity must be one of {QUANTITIES}, got {quantity!r}")
+    if quantity is not None:  # validated by begin_read
         q = quantity
     elif not meas_name:
         q = "brdf"

@@ -44,7 +44,6 @@ from __future__ import annotations
 import math
 import os
 import re
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -55,9 +54,9 @@ from ._common import (
     FormatError,
     angle_factor,
     azimuth_rows,
+    begin_read,
     check_zenith_rows,
     parse_rows,
-    read_text,
 )
 
 __all__ = ["read", "write", "EXTENSIONS", "TAG"]
@@ -75,12 +74,7 @@ def read(path: str | os.PathLike, *, angles: str | None = None, quantity: str | 
 
     ``angles`` and ``quantity`` supply or override the header's declarations.
     """
-    if options:
-        raise TypeError(f"csv.read got unknown options {sorted(options)}")
-    if quantity is not None and quantity not in QUANTITIES:
-        raise ValueError(f"quantity must be one of {QUANTITIES}, got {quantity!r}")
-    path = Path(path)
-    lines = read_text(path)
+    path, lines = begin_read("csv", path, options, quantity)
     header: dict[str, str] = {}
     hline: dict[str, int] = {}
     col_line = None

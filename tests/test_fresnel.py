@@ -206,8 +206,9 @@ def test_invalid_polarization_raises():
 
 
 def test_sincos_kernel_accuracy():
-    # the vectorizable sin/cos used by every kernel (roughbrdf._jit.sincos, fdlibm polynomials)
-    from roughbrdf._jit import SINCOS_MAX_ARG, sincos
+    # the vectorizable sin/cos used by every kernel (the kernel layer's vmath.sincos, fdlibm
+    # polynomials)
+    from roughbrdf._kernels.vmath import SINCOS_MAX_ARG, sincos
 
     rng = np.random.default_rng(0)
     for lo, hi in [(0, math.pi / 2), (-math.pi, math.pi), (-SINCOS_MAX_ARG, SINCOS_MAX_ARG)]:

@@ -28,16 +28,15 @@ as ``Lambda(theta) cos(theta)``, which stays finite at grazing angles.
 
 from __future__ import annotations
 
-import difflib
 import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy import integrate
 
-from ._jit import as_float_array, jit, ufunc
+from .registry import Registry
+from ._kernels import as_float_array, jit, ufunc
 
 __all__ = [
     "Distribution",
@@ -91,29 +90,20 @@ _ENTRIES = [
                  "Trowbridge & Reitz 1975, Fig. 5 (exponent p = 2)"),
 ]
 
-DISTRIBUTIONS: dict[str, Distribution] = {}
+#: every distribution by canonical name and alias (:class:`roughbrdf.registry.Registry`)
+DISTRIBUTIONS: Registry[Distribution] = Registry("distribution")
 for _d in _ENTRIES:
-    for _key in (_d.name, *_d.aliases):
-        DISTRIBUTIONS[_key] = _d
-
-
-def _canon(name: str) -> str:
-    return name.strip().lower().replace("_", "-").replace(" ", "-")
+    DISTRIBUTIONS.add(_d.name, _d, _d.aliases)
 
 
 def names() -> list[str]:
     """Canonical names of the registered distributions."""
-    return [d.name for d in _ENTRIES]
+    return DISTRIBUTIONS.names()
 
 
 def get(name: str) -> Distribution:
     """Look up a distribution by name or alias (case and ``_``/``-`` insensitive)."""
-    key = _canon(str(name))
-    if key in DISTRIBUTIONS:
-        return DISTRIBUTIONS[key]
-    close = difflib.get_close_matches(key, list(DISTRIBUTIONS), n=3, cutoff=0.5)
-    hint = f"; did you mean {', '.join(repr(c) for c in close)}?" if close else ""
-    raise ValueError(f"unknown distribution {name!r}{hint} (known: {', '.join(names())})")
+    return DISTRIBUTIONS.get(name)
 
 
 def check_param(code: int, value: float, name: str = "") -> None:
@@ -182,6 +172,8 @@ def _peak(code, c, a):
 # --------------------------------------------------------------------------------------------
 @functools.lru_cache(maxsize=4096)
 def _numeric_norm(code: int, a: float) -> float:
+    from scipy import integrate  # imported here: SciPy costs start-up time most users never need
+
     def integrand(alpha: float) -> float:
         c = math.cos(alpha)
         return 2 * math.pi * float(_peak(code, c, a)) * c * math.sin(alpha)

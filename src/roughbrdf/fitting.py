@@ -97,8 +97,8 @@ from scipy.optimize import least_squares
 from scipy.stats import qmc
 
 from .measurement import Measurement
-from .models.base import Model
-from .models.base import model as _make_model
+from .models import Model, PreparedGeometry
+from .models import model as _make_model
 
 __all__ = ["fit", "FitResult", "ChannelFit", "LOSSES", "APERTURE_POINTS",
            "aperture_stencil", "aperture_average"]
@@ -291,17 +291,18 @@ def aperture_average(model: Model, theta_i: Any, theta_r: Any, phi: Any,
     a = _check_aperture(aperture, points)
     if quantity not in ("brdf", "bridf"):
         raise ValueError(f"quantity must be 'brdf' or 'bridf', got {quantity!r}")
-    ti, tr, ph, gam = model._prepare(theta_i, theta_r, phi, polarization)
-    flag = 1 if quantity == "bridf" else 0
+    g = model.prepare(theta_i, theta_r, phi, polarization)
+    ti, tr, ph, gam = g.theta_i, g.theta_r, g.phi, g.gamma
     if a is None:
-        return model._evaluate(ti, tr, ph, gam, flag)
+        return model.evaluate_prepared(g, quantity)
     ti, tr, ph, gam = np.broadcast_arrays(ti, tr, ph, gam)
     shape = ti.shape
     tr_s, ph_s, wt = _aperture_directions(tr.ravel(), ph.ravel(), a, points)
     ti_s = np.broadcast_to(ti.reshape(-1, 1), tr_s.shape)
     gam_s = np.broadcast_to(gam.reshape(-1, 1), tr_s.shape)
-    f = np.asarray(model._evaluate(np.ascontiguousarray(ti_s), tr_s, ph_s,
-                                   np.ascontiguousarray(gam_s), flag), dtype=float)
+    f = np.asarray(model.evaluate_prepared(PreparedGeometry(
+        np.ascontiguousarray(ti_s), tr_s, ph_s, np.ascontiguousarray(gam_s)), quantity),
+        dtype=float)
     out = f.reshape(tr_s.shape) @ wt
     return float(out[0]) if shape == () else out.reshape(shape)
 
@@ -346,8 +347,9 @@ class _Objective:
         """Model values at the samples (one call of the compiled kernel); with an aperture, the
         weighted average over the stencil of each sample."""
         self.nfev += 1
-        f = np.asarray(self.model_at(theta)._evaluate(self.ti, self.tr, self.ph, self.gamma,
-                                                      self.flag), dtype=float)
+        f = np.asarray(self.model_at(theta).evaluate_prepared(
+            PreparedGeometry(self.ti, self.tr, self.ph, self.gamma),
+            "brdf_cos" if self.flag else "brdf"), dtype=float)
         if self.stencil is not None:
             f = f.reshape(self.n, self.stencil.size) @ self.stencil
         return f

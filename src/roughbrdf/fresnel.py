@@ -31,14 +31,14 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._jit import TINY, as_float_array, jit, sincos, ufunc
+from ._kernels import TINY, as_float_array, jit, sincos, ufunc
 
 __all__ = ["fresnel_sp", "fresnel_polarized", "fresnel_polarized_cs", "fresnel_polarized_xy",
            "reflectance",
            "polarization_angle", "check_index"]
 
 
-@jit(inline=True, contract=False)  # plain rounding: see roughbrdf._jit.jit
+@jit(inline=True, contract=False)  # plain rounding: see roughbrdf._kernels.compile.jit
 def fresnel_sp(c, n, k):
     """Scalar part: ``(R_s, R_p)`` at ``cos t = c`` for index ``n + i k`` (MODELS.md §1.4)."""
     s2 = 1.0 - c * c

@@ -36,7 +36,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._jit import SINCOS_MAX_ARG, TINY, as_float_array, jit, sincos, ufunc
+from ._kernels import SINCOS_MAX_ARG, TINY, as_float_array, jit, sincos, ufunc
 
 HALF_PI = 0.5 * math.pi
 
@@ -106,7 +106,7 @@ def check_angles(
 
     ``grazing_incidence=False`` rejects ``theta_i = pi/2`` for models that divide by
     ``cos theta_i``. ``phi`` may be any finite angle (it is periodic); azimuths beyond
-    ``roughbrdf._jit.SINCOS_MAX_ARG`` (8e5 rad) are reduced to [0, 2 pi) here, because the
+    ``roughbrdf._kernels.vmath.SINCOS_MAX_ARG`` (8e5 rad) are reduced to [0, 2 pi) here, because the
     kernels' sine/cosine are accurate only up to there.
     """
     ti = check_zenith(theta_i, "theta_i", open_upper=not grazing_incidence)
@@ -131,7 +131,7 @@ def half_vector(ti, tr, phi):
     Returns ``(hx, hy, hz, cos_d, cos_i, cos_r, sin_i)`` where ``h`` is the unit half vector
     (``hz = cos theta_h``) and ``cos_d = w_i . h = |w_i + w_r|/2``.
     """
-    si, ci = sincos(ti)  # vectorizable sin/cos (see roughbrdf._jit.sincos)
+    si, ci = sincos(ti)  # vectorizable sin/cos (see roughbrdf._kernels.vmath.sincos)
     sr, cr = sincos(tr)
     sp, cp = sincos(phi)
     # cos(pi/2) is 6e-17, not 0; clip so that exact grazing gives exactly zero cosines.
@@ -147,7 +147,7 @@ def half_vector(ti, tr, phi):
         # direction, G = 0 at grazing incidence). Return a horizontal "half vector" with
         # cos_d = 0, so that every model gives its shadowed limit (nothing reflects) there.
         return 1.0, 0.0, 0.0, 0.0, ci, cr, si
-    inv = 1.0 / (length + TINY)  # TINY: see roughbrdf._jit (compiled code runs both sides)
+    inv = 1.0 / (length + TINY)  # TINY: see roughbrdf._kernels.vmath.TINY (compiled code runs both sides)
     return sx * inv, sy * inv, sz * inv, 0.5 * length, ci, cr, si
 
 

@@ -24,7 +24,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .geometry import check_zenith
-from .models.base import Model, polarization_array
+from .models.base import Model, PreparedGeometry
+from .polarization import Polarization
 
 __all__ = ["albedo", "reciprocity_error"]
 
@@ -54,7 +55,7 @@ def albedo(model: Model, theta_i: ArrayLike, *, polarization=None, n_psi: int = 
     0.5
     """
     ti = check_zenith(theta_i, "theta_i", open_upper=not model.grazing_incidence)
-    gamma = polarization_array(polarization)
+    gamma = Polarization.parse(polarization).gamma
     if gamma.ndim:
         raise ValueError("albedo takes one polarization for all incidences")
     shape = ti.shape
@@ -75,7 +76,9 @@ def albedo(model: Model, theta_i: ArrayLike, *, polarization=None, n_psi: int = 
     wz = np.clip(cr_ * sz + sr_ * tz, 0.0, 1.0)
     theta_r = np.arccos(wz)
     phi = np.arctan2(wy, wx)
-    f = model._evaluate(np.broadcast_to(t, theta_r.shape), theta_r, phi, gamma, 1)  # f cos(theta_r)
+    # the directions are built here inside the hemisphere: no second validation
+    g = PreparedGeometry(np.broadcast_to(t, theta_r.shape), theta_r, phi, gamma)
+    f = model.evaluate_prepared(g, "brdf_cos")
     integrand = f * sr_ * rho_max * wu[None, None, :]
     out = integrand.sum(axis=(1, 2)) * (2 * math.pi / n_psi)
     out = out.reshape(shape)

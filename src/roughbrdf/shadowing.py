@@ -29,7 +29,6 @@ Smith
 
 from __future__ import annotations
 
-import difflib
 import math
 
 import numpy as np
@@ -37,7 +36,8 @@ from numpy.typing import ArrayLike
 
 from . import distributions as _dist
 from . import special as _special
-from ._jit import TINY, as_float_array, jit, ufunc
+from .registry import Registry
+from ._kernels import TINY, as_float_array, jit, ufunc
 from .geometry import check_angles, half_vector, ts67_projected
 
 __all__ = [
@@ -62,31 +62,23 @@ __all__ = [
 ]
 
 NONE, V_GROOVE, SMITH_SEPARABLE, SMITH_HEIGHT_CORRELATED = 0, 1, 2, 3
-_NAMES = {
-    "none": NONE, "no": NONE, "off": NONE,
-    "v-groove": V_GROOVE, "torrance-sparrow": V_GROOVE, "ts67": V_GROOVE, "v-cavity": V_GROOVE,
-    "smith-separable": SMITH_SEPARABLE, "smith-uncorrelated": SMITH_SEPARABLE,
-    "smith-height-correlated": SMITH_HEIGHT_CORRELATED, "smith": SMITH_HEIGHT_CORRELATED,
-}
-_CANONICAL = {NONE: "none", V_GROOVE: "v-groove", SMITH_SEPARABLE: "smith-separable",
-              SMITH_HEIGHT_CORRELATED: "smith-height-correlated"}
+#: shadowing codes by canonical name and alias (:class:`roughbrdf.registry.Registry`)
+SHADOWING: Registry[int] = Registry("shadowing")
+SHADOWING.add("none", NONE, ("no", "off"))
+SHADOWING.add("v-groove", V_GROOVE, ("torrance-sparrow", "ts67", "v-cavity"))
+SHADOWING.add("smith-separable", SMITH_SEPARABLE, ("smith-uncorrelated",))
+SHADOWING.add("smith-height-correlated", SMITH_HEIGHT_CORRELATED, ("smith",))
+_CANONICAL = {code: name for name in SHADOWING for code in (SHADOWING.get(name),)}
 
 
 def names() -> list[str]:
     """Canonical shadowing names."""
-    return list(_CANONICAL.values())
+    return SHADOWING.names()
 
 
 def get(name: str | None) -> int:
     """Code of a shadowing function by name or alias (``None`` means ``"none"``)."""
-    if name is None:
-        return NONE
-    key = str(name).strip().lower().replace("_", "-").replace(" ", "-")
-    if key in _NAMES:
-        return _NAMES[key]
-    close = difflib.get_close_matches(key, list(_NAMES), n=3, cutoff=0.5)
-    hint = f"; did you mean {', '.join(repr(c) for c in close)}?" if close else ""
-    raise ValueError(f"unknown shadowing {name!r}{hint} (known: {', '.join(names())})")
+    return NONE if name is None else SHADOWING.get(name)
 
 
 def canonical(code: int) -> str:
@@ -108,7 +100,7 @@ def v_groove_g(ci, cr, ch, cd):
     """Scalar TS67 V-groove G from cosines (closed form, MODELS.md §2.5)."""
     if cd <= 0.0:
         return 0.0  # w_i = -w_r (grazing, opposite): nothing reflects
-    # + TINY: compiled code may evaluate this side also when cd = 0 (see roughbrdf._jit.TINY)
+    # + TINY: compiled code may evaluate this side also when cd = 0 (see roughbrdf._kernels.vmath.TINY)
     return min(1.0, 2.0 * ch * cr / (cd + TINY), 2.0 * ch * ci / (cd + TINY))
 
 
@@ -121,7 +113,7 @@ def v_groove_g_over_cos_r(ci, cr, ch, cd):
     """
     if cd <= 0.0:
         return 0.0
-    masking = 2.0 * ch / (cd + TINY)  # + TINY: see roughbrdf._jit.TINY
+    masking = 2.0 * ch / (cd + TINY)  # + TINY: see roughbrdf._kernels.vmath.TINY
     if cr <= 0.0:
         return masking  # the G=1 and shadowing candidates are +inf at theta_r = 90 deg
     inv_cr = 1.0 / (cr + TINY)

@@ -45,7 +45,7 @@ from numba import types
 from numba.extending import intrinsic
 from numpy.typing import ArrayLike
 
-from ._jit import DISABLE_JIT, as_float_array, jit, ufunc
+from ._kernels import DISABLE_JIT, as_float_array, jit, ufunc
 
 __all__ = ["gammaincc", "gammaincc_q", "gammaincc_int", "stirlerr", "bd0", "FINITE_SUM_MAX",
            "INT_HORNER_MAX", "vexp", "vlog", "vlog1p", "vasin"]
@@ -204,7 +204,7 @@ def gammaincc(a: ArrayLike, x: ArrayLike) -> np.ndarray:
 # branch-free exp, log, log1p, asin and integer-a Q that LLVM can vectorize
 # --------------------------------------------------------------------------------------------
 # Why hand-written: Numba's LLVM has no vector math library here (no SVML), so a loop calling
-# math.exp/log/asin stays scalar (see roughbrdf._jit). These are written with selects instead
+# math.exp/log/asin stays scalar (see roughbrdf._kernels.vmath). These are written with selects instead
 # of branches and without libm calls, so a model loop that uses them vectorizes (the RB08 fast
 # path). Argument reductions and the log/asin coefficients are fdlibm's (e_log.c, e_asin.c);
 # exp uses a degree-13 Taylor polynomial (no division). Accuracy is tested against NumPy

@@ -23,63 +23,13 @@ from .common import parse_params
 
 
 def build_model(spec: str, params: dict[str, Any] | None = None) -> _models.Model:
-    """A model from ``name`` or ``name1+name2`` and ``-p`` settings.
-
-    In a sum, a setting may use the prefixed parameter name (``tr75_e``, as ``roughbrdf models``
-    and the fit report show it) or a plain name or option that belongs to exactly one component
-    (``distribution=beckmann``).
-    """
-    params = dict(params or {})
-    names = [s.strip() for s in spec.split("+")]
-    if not all(names):
-        raise ValueError(f"bad model {spec!r}: expected NAME or NAME+NAME")
-    if len(names) == 1:
-        return _models.model(names[0], **params)
-    defaults = [_models.model(n) for n in names]
-    total = defaults[0]
-    for d in defaults[1:]:
-        total = total + d
-    per: list[dict[str, Any]] = [{} for _ in names]
-    for key, val in params.items():
-        hit = [i for i, pre in enumerate(total.prefixes)
-               if key.startswith(pre) and key[len(pre):] in defaults[i].params]
-        if hit:
-            i = hit[0]
-            per[i][key[len(total.prefixes[i]):]] = val
-            continue
-        hit = [i for i, d in enumerate(defaults) if key in d.params or key in d.options]
-        if len(hit) == 1:
-            per[hit[0]][key] = val
-        elif not hit:
-            raise ValueError(f"unknown parameter {key!r} for {spec}; parameters: "
-                             f"{', '.join(total.param_names)}")
-        else:
-            raise ValueError(f"{key!r} is ambiguous in {spec}; use one of "
-                             + ", ".join(total.prefixes[i] + key for i in hit))
-    comps = [_models.model(n, **kw) for n, kw in zip(names, per, strict=True)]
-    out = comps[0]
-    for c in comps[1:]:
-        out = out + c
-    return out
+    """A model from ``name`` or ``name1+name2`` and ``-p`` settings (:func:`roughbrdf.model`)."""
+    return _models.model(spec, **(params or {}))
 
 
 def resolve_names(model: _models.Model, names: list[str]) -> list[str]:
     """Map ``--fix`` names to the model's parameter names (plain names allowed in sums)."""
-    out = []
-    for nm in names:
-        if nm in model.param_names:
-            out.append(nm)
-            continue
-        hit = [p for p in model.param_names if "_" in p and p.split("_", 1)[1] == nm
-               and any(p == pre + nm for pre in getattr(model, "prefixes", []))]
-        if len(hit) == 1:
-            out.append(hit[0])
-        elif hit:
-            raise ValueError(f"{nm!r} is ambiguous; use one of {', '.join(hit)}")
-        else:
-            raise ValueError(f"unknown parameter {nm!r}; parameters: "
-                             f"{', '.join(model.param_names)}")
-    return out
+    return _models.resolve_names(model, names)
 
 
 def register(app: typer.Typer) -> None:

@@ -1,9 +1,17 @@
-"""Models: one module per published model, plus Lambertian, generic microfacet and sums."""
+"""Models: one module per published model, plus Lambertian, generic microfacet and sums.
 
-from .base import MODELS, Model, Parameter, SumModel, available, model, register
+``base`` (the :class:`Model` class and its evaluation interface, the registry), ``parameters``
+(:class:`Parameter`), ``sum`` (:class:`SumModel`), ``factory`` (:func:`model` by name or
+``"a+b"``), and one module per model.
+"""
+
+from .base import MODELS, Model, PreparedGeometry, register
+from .factory import available, model, resolve_names
 from .lambertian import Lambertian
 from .microfacet import Microfacet
+from .parameters import Parameter
 from .renhorn_boreman import RenhornBoreman2008
+from .sum import SumModel
 from .torrance_sparrow import TorranceSparrow1967
 from .trowbridge_reitz import TrowbridgeReitz1975
 
@@ -11,10 +19,12 @@ __all__ = [
     "MODELS",
     "Model",
     "Parameter",
+    "PreparedGeometry",
     "SumModel",
     "available",
     "model",
     "register",
+    "resolve_names",
     "Lambertian",
     "Microfacet",
     "RenhornBoreman2008",

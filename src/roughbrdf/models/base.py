@@ -1,123 +1,75 @@
-"""Model base class, named parameters, sums of models and the model registry.
+"""The model base class and its one public evaluation interface; the model registry.
 
 A model is pure: parameters in, values out. It knows nothing about fitting; a fitter reads
 ``parameters`` (value, bounds, unit) and rebuilds the model with :meth:`Model.with_values`.
 
+Evaluation
+----------
+:meth:`Model.evaluate` is the one public evaluation method: angles (radians, the library's
+frame, ``docs/models.md`` §1.1), a :class:`~roughbrdf.quantity.Quantity` and a
+:class:`~roughbrdf.polarization.Polarization` (or anything :meth:`Polarization.parse` takes).
+:meth:`Model.brdf` and :meth:`Model.bridf` are shorthands. For repeated calls on the same
+samples (a fit), :meth:`Model.prepare` validates and broadcasts the inputs once and
+:meth:`Model.evaluate_prepared` evaluates on the result.
+
 Every model supplies one compiled scalar function ``point(theta_i, theta_r, phi, gamma, p, flag)``
-returning the BRDF (``flag = 0``) or the BRIDF ``f_r cos(theta_r)`` (``flag = 1``) for the packed
-numeric parameter tuple ``p`` (:meth:`Model._pack`); :func:`roughbrdf._jit.evaluate` broadcasts it
-over NumPy arrays in parallel.
+returning the BRDF (``flag = 0``) or ``f_r cos(theta_r)`` (``flag = 1``) for the packed numeric
+parameter tuple ``p`` (``_pack``), and a module-level parallel loop over it (``_drive``, a
+:func:`roughbrdf._kernels.driver`); :func:`roughbrdf._kernels.evaluate` broadcasts NumPy inputs
+onto it.
 """
 
 from __future__ import annotations
 
 import copy
-import difflib
-import math
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .. import _jit
-from ..fresnel import polarization_angle
+from .. import _kernels
 from ..geometry import check_angles
+from ..polarization import Polarization
+from ..quantity import Quantity
+from ..registry import Registry, unknown_name
+from .parameters import Parameter
 
-__all__ = ["Parameter", "Model", "SumModel", "register", "model", "available", "MODELS"]
+if TYPE_CHECKING:
+    from .sum import SumModel
+
+__all__ = ["Model", "PreparedGeometry", "MODELS", "register"]
 
 
 @dataclass(frozen=True)
-class Parameter:
-    """A named model parameter.
+class PreparedGeometry:
+    """Validated, broadcastable float64 inputs of an evaluation (:meth:`Model.prepare`).
 
     Attributes
     ----------
-    name : str
-    value : float or None
-        ``None`` switches an optional part off (e.g. TS67 ``n=None`` gives F = 1).
-    bounds : (float, float)
-        Default search range for fits (finite, inside the physical domain).
-    unit : str
-    description : str
-    domain : (float, bool, float, bool)
-        Physical domain ``(low, low_inclusive, high, high_inclusive)``; values outside raise.
-    optional : bool
-        Whether ``None`` is accepted.
+    theta_i, theta_r, phi : numpy.ndarray
+        Angles in radians (checked against the model's domain; ``phi`` reduced).
+    gamma : numpy.ndarray
+        TR75's polarization angle per sample, NaN = unpolarized
+        (:class:`~roughbrdf.polarization.Polarization`).
     """
 
-    name: str
-    value: float | None
-    bounds: tuple[float, float]
-    unit: str = ""
-    description: str = ""
-    domain: tuple[float, bool, float, bool] = (-math.inf, False, math.inf, False)
-    optional: bool = False
+    theta_i: np.ndarray
+    theta_r: np.ndarray
+    phi: np.ndarray
+    gamma: np.ndarray
 
-    def check(self, value: Any) -> float | None:
-        """Validate ``value`` against the domain; return it as float (or None)."""
-        if value is None:
-            if self.optional:
-                return None
-            raise ValueError(f"parameter {self.name!r} cannot be None")
-        try:
-            v = float(value)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"parameter {self.name!r} must be a number, got {value!r}") from exc
-        lo, lo_inc, hi, hi_inc = self.domain
-        ok = (math.isfinite(v) and (v >= lo if lo_inc else v > lo)
-              and (v <= hi if hi_inc else v < hi))
-        if not ok:
-            lo_s = ("[" if lo_inc else "(") + f"{lo:g}"
-            hi_s = f"{hi:g}" + ("]" if hi_inc else ")")
-            raise ValueError(
-                f"parameter {self.name!r} = {value!r} is outside its physical domain "
-                f"{lo_s}, {hi_s}" + (f" ({self.description})" if self.description else "")
-            )
-        return v
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """The broadcast shape of the samples."""
+        return np.broadcast_shapes(self.theta_i.shape, self.theta_r.shape, self.phi.shape,
+                                   self.gamma.shape)
 
-
-def positive(name: str, default: float, bounds: tuple[float, float], unit: str, desc: str,
-             **kw: Any) -> Parameter:
-    """A parameter that must be > 0."""
-    return Parameter(name, default, bounds, unit, desc, (0.0, False, math.inf, False), **kw)
-
-
-def nonnegative(name: str, default: float, bounds: tuple[float, float], unit: str, desc: str,
-                **kw: Any) -> Parameter:
-    """A parameter that must be >= 0."""
-    return Parameter(name, default, bounds, unit, desc, (0.0, True, math.inf, False), **kw)
-
-
-def unit_interval(name: str, default: float, desc: str) -> Parameter:
-    """A reflectance-like parameter in [0, 1]."""
-    return Parameter(name, default, (0.0, 1.0), "1", desc, (0.0, True, 1.0, True))
-
-
-def _canon(name: str) -> str:
-    return str(name).strip().lower().replace("_", "-").replace(" ", "-")
-
-
-def _unknown(kind: str, name: str, known: Iterable[str]) -> ValueError:
-    known = list(known)
-    close = difflib.get_close_matches(name, known, n=3, cutoff=0.5)
-    hint = f"; did you mean {', '.join(repr(c) for c in close)}?" if close else ""
-    return ValueError(f"unknown {kind} {name!r}{hint} (known: {', '.join(known)})")
-
-
-def polarization_array(polarization: Any) -> np.ndarray:
-    """Polarization argument -> array of TR75 ``gamma`` angles (NaN = unpolarized)."""
-    if polarization is None or isinstance(polarization, str | float | int):
-        return np.asarray(polarization_angle(polarization), dtype=np.float64)
-    arr = np.asarray(polarization)
-    if arr.dtype.kind in "US":
-        return np.vectorize(polarization_angle, otypes=[np.float64])(arr)
-    arr = _jit.as_float_array(arr, "polarization")
-    if np.isinf(arr).any():
-        bad = arr[np.isinf(arr)].flat[0]
-        raise ValueError(f"polarization angle gamma must be finite, got {bad!r}")
-    return arr  # NaN entries mean unpolarized
+    def specular(self) -> PreparedGeometry:
+        """The specular direction (``theta_r = theta_i``, ``phi = 0``) of each sample."""
+        return PreparedGeometry(self.theta_i, self.theta_i, np.zeros_like(self.theta_i),
+                                self.gamma)
 
 
 class Model:
@@ -125,8 +77,10 @@ class Model:
 
     Subclasses define ``name``, ``short`` (prefix in sums), ``reference``, ``PARAMETERS`` (a tuple
     of :class:`Parameter` with default values), optional ``OPTIONS`` (non-numeric settings with
-    defaults), ``grazing_incidence`` (whether theta_i = pi/2 is allowed), and ``_point`` and
-    ``_pack`` (and optionally ``_drive``, see :mod:`roughbrdf._jit`).
+    defaults), ``grazing_incidence`` (whether theta_i = pi/2 is allowed), ``_pack`` (the numeric
+    parameters as a tuple of floats) and ``_drive`` (the compiled driver, see
+    :mod:`roughbrdf._kernels.compile`); a model with its own evaluation path overrides
+    ``_kernel`` instead.
     """
 
     name: ClassVar[str] = ""
@@ -137,9 +91,9 @@ class Model:
     OPTIONS: ClassVar[dict[str, Any]] = {}
     grazing_incidence: ClassVar[bool] = False
     reciprocal: ClassVar[bool] = True
-    _point: ClassVar[Callable | None] = None
-    #: optional module-level parallel loop over ``_point`` (``roughbrdf._jit.driver``): the
-    #: vectorized, disk-cached fast path; without it the generic driver is used.
+    TERMS: ClassVar[tuple[str, ...]] = ()
+    #: the module-level parallel loop over the model's scalar kernel
+    #: (:func:`roughbrdf._kernels.driver`): vectorized and cached on disk
     _drive: ClassVar[Callable | None] = None
 
     def __init__(self, **kwargs: Any) -> None:
@@ -152,8 +106,8 @@ class Model:
             elif key in options:
                 options[key] = val
             else:
-                raise _unknown(f"parameter for model {self.name!r}", key,
-                               [*specs, *options])
+                raise unknown_name(f"parameter for model {self.name!r}", key,
+                                   [*specs, *options])
         self._options = self._check_options(options)
         self._specs = self._parameter_specs()
         self._values = values
@@ -207,29 +161,37 @@ class Model:
         specs = {p.name: p for p in self._specs}
         for nm, v in zip(names, values, strict=True):
             if nm not in specs:
-                raise _unknown(f"parameter for model {self.name!r}", nm, specs)
+                raise unknown_name(f"parameter for model {self.name!r}", nm, specs)
             new._values[nm] = specs[nm].check(v)
         new._validate()
         return new
 
     # -- evaluation -----------------------------------------------------------------------------
-    def _evaluate(self, ti: np.ndarray, tr: np.ndarray, phi: np.ndarray, gamma: np.ndarray,
-                  flag: int, term: str | None = None) -> np.ndarray | float:
-        """Evaluate on already validated float arrays (used by fitters)."""
-        if term is not None:
-            raise ValueError(f"model {self.name!r} has no separate terms; got term={term!r}")
-        cls = type(self)
-        return _jit.evaluate(cls._point, ti, tr, phi, gamma, self._pack(), flag, cls._drive)
+    def prepare(self, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
+                polarization: Any = None) -> PreparedGeometry:
+        """Validate and convert the inputs once, for repeated :meth:`evaluate_prepared` calls.
 
-    def _prepare(self, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
-                 polarization: Any) -> tuple[np.ndarray, ...]:
+        Raises ``ValueError`` naming the argument and the offending value for angles outside
+        the hemisphere (or ``theta_i = pi/2`` where the model is not defined there) and for a
+        bad polarization.
+        """
         ti, tr, ph = check_angles(theta_i, theta_r, phi,
                                   grazing_incidence=self.grazing_incidence)
-        return ti, tr, ph, polarization_array(polarization)
+        return PreparedGeometry(ti, tr, ph, Polarization.parse(polarization).gamma)
 
-    def brdf(self, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
-             polarization: Any = None, *, term: str | None = None) -> np.ndarray | float:
-        """Standard BRDF ``f_r`` in sr⁻¹ (radiance / irradiance).
+    def evaluate_prepared(self, geometry: PreparedGeometry, quantity: Quantity | str = "brdf",
+                          *, term: str | None = None) -> np.ndarray | float:
+        """Evaluate on inputs from :meth:`prepare` (see :meth:`evaluate` for ``quantity``)."""
+        q = Quantity.parse(quantity)
+        if q is Quantity.RELATIVE:
+            num = self._kernel(geometry, 0, term)
+            return num / self._kernel(geometry.specular(), 0, term)
+        return self._kernel(geometry, 1 if q.cosine_weighted else 0, term)
+
+    def evaluate(self, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike, *,
+                 quantity: Quantity | str = "brdf", polarization: Any = None,
+                 term: str | None = None) -> np.ndarray | float:
+        """The model's value of ``quantity`` at the given geometries.
 
         Parameters
         ----------
@@ -238,31 +200,64 @@ class Model:
             for models that divide by ``cos theta_i``).
         phi : array_like
             Azimuth of the reflected ray, radians, 0 on the forward (specular) side.
-        polarization : None, "unpolarized", "s", "p", float or array
-            Incident polarization: TR75's angle ``gamma`` of the electric field from the plane
-            of incidence (radians); arrays give one polarization per sample.
+        quantity : Quantity or str
+            ``"brdf"`` (f_r, sr⁻¹), ``"brdf_cos"``/``"bridf"`` (f_r cos theta_r, sr⁻¹) or
+            ``"relative"`` (f_r divided by f_r at the specular direction ``theta_r = theta_i,
+            phi = 0`` of the same incidence; TS67 Eq. 23, ``docs/models.md`` §2.3).
+        polarization : Polarization, None, "unpolarized", "s", "p", float or array
+            Incident polarization (:class:`~roughbrdf.polarization.Polarization`): TR75's angle
+            ``gamma`` of the electric field from the plane of incidence (radians); arrays give
+            one polarization per sample.
         term : str, optional
-            A single term of a model that has several (e.g. RB08 ``"surface"``).
+            A single term of a model that has several (e.g. RB08 ``"surface"``), or a
+            component of a sum by its prefix.
 
         Returns
         -------
         numpy.ndarray or float
             Broadcast shape of the inputs; a float if every input was a scalar.
+
+        Examples
+        --------
+        >>> import roughbrdf as rb
+        >>> m = rb.model("lambertian", rho=0.5)
+        >>> round(m.evaluate(0.3, 0.0, 0.0, quantity="brdf_cos"), 6)   # rho cos(0)/pi
+        0.159155
         """
-        return self._evaluate(*self._prepare(theta_i, theta_r, phi, polarization), 0, term)
+        g = self.prepare(theta_i, theta_r, phi, polarization)
+        return self.evaluate_prepared(g, quantity, term=term)
+
+    def brdf(self, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
+             polarization: Any = None, *, term: str | None = None) -> np.ndarray | float:
+        """Standard BRDF ``f_r`` in sr⁻¹: ``evaluate(..., quantity="brdf")``."""
+        return self.evaluate(theta_i, theta_r, phi, quantity=Quantity.BRDF,
+                             polarization=polarization, term=term)
 
     def bridf(self, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
               polarization: Any = None, *, term: str | None = None) -> np.ndarray | float:
         """TR75's BRIDF ``f_r cos(theta_r)`` in sr⁻¹ (finite at theta_r = pi/2)."""
-        return self._evaluate(*self._prepare(theta_i, theta_r, phi, polarization), 1, term)
+        return self.evaluate(theta_i, theta_r, phi, quantity=Quantity.BRIDF,
+                             polarization=polarization, term=term)
 
     __call__ = brdf
 
+    def _kernel(self, g: PreparedGeometry, flag: int, term: str | None) -> np.ndarray | float:
+        """The compiled evaluation (``flag`` 0: f_r, 1: f_r cos theta_r); models with terms or
+        their own drivers override it."""
+        if term is not None:
+            raise ValueError(f"model {self.name!r} has no separate terms; got term={term!r}")
+        drive = type(self)._drive
+        if drive is None:  # pragma: no cover - every registered model has a driver
+            raise NotImplementedError(f"model {self.name!r} has no compiled driver")
+        return _kernels.evaluate(drive, g.theta_i, g.theta_r, g.phi, g.gamma, self._pack(), flag)
+
     # -- composition and description ------------------------------------------------------------
     def __add__(self, other: Model) -> SumModel:
+        from .sum import SumModel, components
+
         if not isinstance(other, Model):
             return NotImplemented
-        return SumModel([*_components(self), *_components(other)])
+        return SumModel([*components(self), *components(other)])
 
     def to_dict(self) -> dict[str, Any]:
         """``{"model": name, "params": {...}, "options": {...}}``; round-trips via :func:`model`."""
@@ -282,131 +277,14 @@ class Model:
         return f"rb.model({self.name!r}, {args})"
 
 
-def _components(m: Model) -> list[Model]:
-    return list(m.components) if isinstance(m, SumModel) else [m]
-
-
-class SumModel(Model):
-    """Sum of models; parameter names are prefixed ``<short>_<name>`` (``<short><i>_`` if repeated).
-    """
-
-    name = "sum"
-    short = "sum"
-
-    def __init__(self, components: Sequence[Model]) -> None:  # noqa: D107
-        self.components = [copy.copy(c) for c in components]
-        counts: dict[str, int] = {}
-        for c in self.components:
-            counts[c.short] = counts.get(c.short, 0) + 1
-        seen: dict[str, int] = {}
-        self.prefixes = []
-        for c in self.components:
-            if counts[c.short] > 1:
-                seen[c.short] = seen.get(c.short, 0) + 1
-                self.prefixes.append(f"{c.short}{seen[c.short]}_")
-            else:
-                self.prefixes.append(f"{c.short}_")
-        self.grazing_incidence = all(c.grazing_incidence for c in self.components)  # type: ignore[misc]
-        self.reciprocal = all(c.reciprocal for c in self.components)  # type: ignore[misc]
-        self._options = {}
-        self._refresh()
-
-    def _refresh(self) -> None:
-        self._specs = tuple(replace(p, name=pre + p.name) for c, pre in
-                            zip(self.components, self.prefixes, strict=True) for p in c.parameters)
-        self._values = {p.name: p.value for p in self._specs}
-
-    def _split(self, name: str) -> tuple[int, str]:
-        for i, pre in enumerate(self.prefixes):
-            if name.startswith(pre) and name[len(pre):] in self.components[i].params:
-                return i, name[len(pre):]
-        raise _unknown("parameter for this sum of models", name, [p.name for p in self._specs])
-
-    def with_values(self, names: Sequence[str], values: Sequence[float]) -> SumModel:
-        groups: dict[int, tuple[list[str], list[float]]] = {}
-        for nm, v in zip(names, values, strict=True):
-            i, base = self._split(nm)
-            groups.setdefault(i, ([], []))[0].append(base)
-            groups[i][1].append(v)
-        new = copy.copy(self)
-        new.components = [c.with_values(*groups[i]) if i in groups else c
-                          for i, c in enumerate(self.components)]
-        new._refresh()
-        return new
-
-    def with_params(self, **updates: Any) -> SumModel:
-        return self.with_values(list(updates), list(updates.values()))
-
-    def _evaluate(self, ti, tr, phi, gamma, flag, term=None):
-        parts = []
-        for c in self.components:
-            if term is None:
-                parts.append(c._evaluate(ti, tr, phi, gamma, flag, None))
-            elif term in getattr(c, "TERMS", ()):
-                parts.append(c._evaluate(ti, tr, phi, gamma, flag, term))
-            elif term in (c.short, c.name):
-                parts.append(c._evaluate(ti, tr, phi, gamma, flag, None))
-        if not parts:
-            raise ValueError(f"no component of this sum has a term {term!r}")
-        return sum(parts[1:], parts[0])
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"model": "sum", "components": [c.to_dict() for c in self.components]}
-
-    def describe(self) -> str:
-        return "\n".join(f"[{pre[:-1]}] " + c.describe() for c, pre in
-                         zip(self.components, self.prefixes, strict=True))
-
-    @property
-    def reference(self) -> str:  # type: ignore[override]
-        return "; ".join(c.reference for c in self.components)
-
-    def __repr__(self) -> str:
-        return " + ".join(repr(c) for c in self.components)
-
-
 # --------------------------------------------------------------------------------------------
 # registry
 # --------------------------------------------------------------------------------------------
-MODELS: dict[str, type[Model]] = {}
+#: every registered model class by canonical name and alias
+MODELS: Registry[type[Model]] = Registry("model")
 
 
 def register(cls: type[Model]) -> type[Model]:
     """Class decorator: register a model under its ``name`` and ``aliases``."""
-    for key in (cls.name, *cls.aliases):
-        MODELS[_canon(key)] = cls
+    MODELS.add(cls.name, cls, cls.aliases)
     return cls
-
-
-def available() -> list[str]:
-    """Canonical names of the registered models."""
-    seen: list[str] = []
-    for cls in MODELS.values():
-        if cls.name not in seen:
-            seen.append(cls.name)
-    return seen
-
-
-def model(name: str | dict, **params: Any) -> Model:
-    """Build a registered model by name (case-insensitive; aliases accepted).
-
-    Examples
-    --------
-    >>> import roughbrdf as rb
-    >>> m = rb.model("trowbridge-reitz-1975", e=0.68, n=1.0, k=0.9, rho_L=0.33)
-    >>> round(m.bridf(0.0, 0.0, 0.0), 5)      # TR75 cement, normal incidence and view
-    0.13402
-    """
-    if isinstance(name, dict):  # from to_dict()
-        spec = dict(name)
-        if spec.get("model") == "sum":
-            parts = [model(c) for c in spec["components"]]
-            out = parts[0]
-            for p in parts[1:]:
-                out = out + p
-            return out
-        return model(spec["model"], **spec.get("options", {}), **spec.get("params", {}), **params)
-    key = _canon(name)
-    if key not in MODELS:
-        raise _unknown("model", str(name), available())
-    return MODELS[key](**params)

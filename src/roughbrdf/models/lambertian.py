@@ -6,8 +6,9 @@ import math
 
 from numba import prange
 
-from .._jit import at, driver, jit
-from .base import Model, register, unit_interval
+from .._kernels import at, driver, jit
+from .base import Model, register
+from .parameters import unit_interval
 
 
 @jit
@@ -19,7 +20,7 @@ def _lambert_point(ti, tr, phi, gamma, p, flag):
 
 @driver
 def _lambert_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
-    # module-level loop: cached on disk (roughbrdf._jit.driver), unlike the generic driver
+    # module-level loop: cached on disk (roughbrdf._kernels.compile.driver), unlike the generic driver
     for i in prange(out.size):
         out[i] = _lambert_point(at(a, i), at(b, i), at(c, i), at(g, i), p, flag)
 
@@ -42,7 +43,6 @@ class Lambertian(Model):
     reference = "Lambert 1760; TR75 Eq. 32"
     PARAMETERS = (unit_interval("rho", 0.5, "directional-hemispherical reflectance"),)
     grazing_incidence = True
-    _point = _lambert_point
     _drive = _lambert_drive
 
     def _pack(self) -> tuple:

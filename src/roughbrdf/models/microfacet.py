@@ -20,10 +20,11 @@ from numba import prange
 
 from .. import distributions as dist
 from .. import shadowing as shd
-from .._jit import at, driver, jit
+from .._kernels import at, driver, jit
 from ..fresnel import check_index, fresnel_polarized
 from ..geometry import half_vector, tr75_eta_from_h
-from .base import Model, Parameter, nonnegative, positive, register
+from .base import Model, register
+from .parameters import Parameter, nonnegative, positive
 
 
 @jit
@@ -54,7 +55,7 @@ def _micro_point(ti, tr, phi, gamma, p, flag):
 
 @driver
 def _micro_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
-    # module-level loop: cached on disk (roughbrdf._jit.driver), unlike the generic driver
+    # module-level loop: cached on disk (roughbrdf._kernels.compile.driver), unlike the generic driver
     for i in prange(out.size):
         out[i] = _micro_point(at(a, i), at(b, i), at(c, i), at(g, i), p, flag)
 
@@ -84,7 +85,6 @@ class Microfacet(Model):
         nonnegative("ks", 1.0, (0.0, 20.0), "1", "scale of the specular term"),
     )
     OPTIONS = {"distribution": "trowbridge-reitz", "shadowing": "smith-height-correlated"}
-    _point = _micro_point
     _drive = _micro_drive
 
     def _check_options(self, options):

@@ -30,7 +30,7 @@ Kernels (all compiled with Numba, parallel over samples):
 * **fast** (integer ``n, n_r <= 16``, e.g. the defaults; one polarization for all samples;
   analytic N): a branch-free loop that LLVM vectorizes (AVX2/AVX-512): V by a fixed-length
   finite sum, ``exp/log/asin`` from :mod:`roughbrdf.special`, ``sin/cos`` from
-  :func:`roughbrdf._jit.sincos`. A *lean* variant drops Vm (``w_a = 0``) and the second
+  :func:`roughbrdf._kernels.vmath.sincos`. A *lean* variant drops Vm (``w_a = 0``) and the second
   shadowing pair (``w_r, n_r = w, n``). With a scalar ``theta_i`` every incidence quantity is
   hoisted out of the loop. Measured (1e6 random geometries, 2 cores, defaults): ~6e7
   evaluations/s (3.7e7 on one core).
@@ -51,11 +51,13 @@ from typing import Any
 import numpy as np
 from numba import prange
 
-from .. import _jit, special
+from .. import _kernels, special
 from .. import shadowing as shd
-from .._jit import at, driver, jit, sincos
+from .._kernels import at, driver, jit, sincos
 from ..fresnel import check_index, fresnel_sp
-from .base import Model, Parameter, nonnegative, positive, register
+from ..registry import Registry
+from .base import Model, PreparedGeometry, register
+from .parameters import Parameter, nonnegative, positive
 
 __all__ = ["RenhornBoreman2008", "rb08_norm", "lobe_integral"]
 
@@ -72,19 +74,25 @@ POL_WEIGHT = {"unpolarized": 0.5, "s": 1.0, "p": 0.0}  # weight of R_s in R
 TERM_CODES = {None: 0, "surface": 1, "bulk": 2, "retro": 3}
 RETRO_CODES = {"width": 0, "amplitude": 1}  # where the retro V pair acts (_RAMP)
 
-_OPTION_ALIASES = {
-    "zeta": {"angle": "angle", "z-a": "angle", "cosine": "cosine", "z-b": "cosine",
-             "zenith-difference": "zenith-difference", "z-c": "zenith-difference"},
-    "surface_weight": {"geometric-mean": "geometric-mean", "sqrt": "geometric-mean",
-                       "q=1/2": "geometric-mean", "product": "product", "q=1": "product",
-                       "transmission": "transmission"},
-    "normalization": {"literal": "literal", "specular-width": "specular-width",
-                      "numeric": "numeric"},
-    "retro_shadowing": {"width": "width", "amplitude": "amplitude",
-                        "acceptance": "amplitude"},
-    "polarization": {"unpolarized": "unpolarized", "natural": "unpolarized", "none": "unpolarized",
-                     "s": "s", "te": "s", "perpendicular": "s",
-                     "p": "p", "tm": "p", "parallel": "p"},
+def _option(name: str, values: dict[str, tuple[str, ...]]) -> Registry[str]:
+    reg: Registry[str] = Registry(f"value for option {name!r} of model 'renhorn-boreman-2008'")
+    for canonical, aliases in values.items():
+        reg.add(canonical, canonical, aliases)
+    return reg
+
+
+#: the readings (options) of the reconstructed model and their aliases (docs/models.md §4)
+OPTION_VALUES: dict[str, Registry[str]] = {
+    "zeta": _option("zeta", {"angle": ("z-a",), "cosine": ("z-b",),
+                             "zenith-difference": ("z-c",)}),
+    "surface_weight": _option("surface_weight", {"geometric-mean": ("sqrt", "q=1/2"),
+                                                 "product": ("q=1",), "transmission": ()}),
+    "normalization": _option("normalization", {"literal": (), "specular-width": (),
+                                               "numeric": ()}),
+    "retro_shadowing": _option("retro_shadowing", {"width": (), "amplitude": ("acceptance",)}),
+    "polarization": _option("polarization", {"unpolarized": ("natural", "none"),
+                                             "s": ("te", "perpendicular"),
+                                             "p": ("tm", "parallel")}),
 }
 
 
@@ -92,7 +100,7 @@ _OPTION_ALIASES = {
 # scalar parts
 # --------------------------------------------------------------------------------------------
 # Every part on the hot path is branch-free (selects) and free of libm calls (sincos from
-# roughbrdf._jit, vexp/vlog1p/vasin from roughbrdf.special), so that the fast driver's loop
+# roughbrdf._kernels.vmath, vexp/vlog1p/vasin from roughbrdf.special), so that the fast driver's loop
 # vectorizes. ``fast`` (a compile-time constant at each call site) selects the shadowing
 # function: the vectorizable finite sum for integer n <= special.INT_HORNER_MAX, or the
 # general incomplete gamma (series / continued fraction, loops) for any real n.
@@ -305,7 +313,7 @@ def _run(ti, tr, phi, gamma, p: tuple, flag: int, ns=None, nr=None):
             drive(a, _dense_array(tr, shape), _dense_array(phi, shape),
                   float(gamma.reshape(-1)[0]), pt, int(flag), out)
         else:
-            flat = _jit._flat
+            flat = _kernels.broadcast_strided
             nan = np.full(1, math.nan)
             _rb08_general(*flat(ti, shape), *flat(tr, shape), *flat(phi, shape),
                           *flat(gamma, shape), *((nan, 0) if ns is None else flat(ns, shape)),
@@ -324,7 +332,7 @@ def _gl_panels(edges: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
     return (0.5 * (hi - lo) * x + 0.5 * (hi + lo)).ravel(), (0.5 * (hi - lo) * w).ravel()
 
 
-@_jit.ufunc(9)
+@_kernels.ufunc(9)
 def _inv_d_rel(dx, be, a0, ci, v0, scale, a, st, rho):
     # 1/D of the surface lobe at (alpha, beta) = (alpha0 + dx, be), in coordinates relative to
     # the peak: D evaluated from angles (alpha = sin theta_s cos phi) would lose dx below ~1e-16
@@ -476,7 +484,7 @@ def _analytic_specular_width(theta, rho, w, n):
     return _norm_ufunc(ci * ci, a0 * a0, rho * ci * v0)
 
 
-@_jit.ufunc(3)
+@_kernels.ufunc(3)
 def _norm_ufunc(ci2, a02, rho):
     return rb08_norm(ci2, a02, rho)
 
@@ -647,21 +655,10 @@ class RenhornBoreman2008(Model):
     TERMS = ("surface", "bulk", "retro")
     grazing_incidence = False
     reciprocal = False
-    _point = _rb08_point
 
     def _check_options(self, options: dict[str, Any]) -> dict[str, Any]:
-        out = {}
-        for key, val in options.items():
-            table = _OPTION_ALIASES[key]
-            canon = str(val).strip().lower().replace("_", "-").replace(" ", "-")
-            if val is None and key == "polarization":
-                canon = "unpolarized"
-            if canon not in table:
-                choices = sorted(set(table.values()))
-                raise ValueError(f"unknown value {val!r} for option {key!r} of model "
-                                 f"{self.name!r} (known: {', '.join(choices)})")
-            out[key] = table[canon]
-        return out
+        return {key: OPTION_VALUES[key].canonical("unpolarized" if val is None else val)
+                for key, val in options.items()}
 
     def _validate(self) -> None:
         v = self._values
@@ -683,7 +680,9 @@ class RenhornBoreman2008(Model):
                 1.0 if (_horner_ok(v["n"]) and _horner_ok(v["n_r"])) else 0.0,
                 float(RETRO_CODES[o["retro_shadowing"]]))
 
-    def _evaluate(self, ti, tr, phi, gamma, flag, term=None):
+    def _kernel(self, g: PreparedGeometry, flag: int, term: str | None
+                ) -> np.ndarray | float:
+        ti, tr, phi, gamma = g.theta_i, g.theta_r, g.phi, g.gamma
         if term not in TERM_CODES:
             raise ValueError(f"model {self.name!r} has terms {self.TERMS}; got term={term!r}")
         p = self._pack(TERM_CODES[term])

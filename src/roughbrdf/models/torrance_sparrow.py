@@ -25,11 +25,12 @@ from numba import prange
 from numpy.typing import ArrayLike
 
 from .. import distributions as dist
-from .._jit import at, driver, jit
+from .._kernels import at, driver, jit
 from ..fresnel import check_index, fresnel_polarized
 from ..geometry import half_vector, tr75_eta_from_h
 from ..shadowing import v_groove_g_over_cos_cos, v_groove_g_over_cos_r
-from .base import Model, Parameter, nonnegative, positive, register
+from .base import Model, register
+from .parameters import Parameter, nonnegative, positive
 
 
 @jit
@@ -55,7 +56,7 @@ def _ts67_point(ti, tr, phi, gamma, p, flag):
 
 @driver
 def _ts67_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
-    # module-level loop: cached on disk (roughbrdf._jit.driver), unlike the generic driver
+    # module-level loop: cached on disk (roughbrdf._kernels.compile.driver), unlike the generic driver
     for i in prange(out.size):
         out[i] = _ts67_point(at(a, i), at(b, i), at(c, i), at(g, i), p, flag)
 
@@ -119,7 +120,6 @@ class TorranceSparrow1967(Model):
         return (v["g"], v["c"], v["n"] if use_f else 1.0, (v["k"] or 0.0) if use_f else 0.0,
                 v["rho_d"], 1.0 if use_f else 0.0)
 
-    _point = _ts67_point
     _drive = _ts67_drive
 
     def relative(self, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
@@ -130,7 +130,5 @@ class TorranceSparrow1967(Model):
         direction ``G = 1``, ``alpha = 0`` and ``theta_d = psi``, so the ratio of the absolute
         forms is exactly Eq. 23 (``rho_d`` cancels).
         """
-        ti, tr, ph, gam = self._prepare(theta_i, theta_r, phi, polarization)
-        num = self._evaluate(ti, tr, ph, gam, 0)
-        den = self._evaluate(ti, ti, np.zeros_like(ti), gam, 0)
-        return num / den
+        return self.evaluate(theta_i, theta_r, phi, quantity="relative",
+                             polarization=polarization)

@@ -27,10 +27,11 @@ from numba import prange
 
 from .. import distributions as dist
 from .. import shadowing as shd
-from .._jit import at, driver, jit
+from .._kernels import at, driver, jit
 from ..fresnel import check_index, fresnel_polarized_xy
 from ..geometry import half_vector, tr75_eta_xy
-from .base import Model, nonnegative, positive, register, unit_interval
+from .base import Model, register
+from .parameters import nonnegative, positive, unit_interval
 
 
 @jit(inline=True)
@@ -101,7 +102,6 @@ class TrowbridgeReitz1975(Model):
         unit_interval("rho_L", 0.33, "Lambertian directional-hemispherical reflectance"),
     )
     OPTIONS = {"shadowing": "none"}
-    _point = _tr75_point
     _drive = _tr75_drive
 
     def _check_options(self, options):

@@ -1,0 +1,76 @@
+"""Broadcasting NumPy inputs onto a model's compiled scalar kernel.
+
+:func:`evaluate` broadcasts the geometry and polarization arrays (NumPy rules), hands the
+model's :func:`~roughbrdf._kernels.compile.driver` scalars as floats and arrays as contiguous
+1-D arrays, and reshapes the result. A kernel may return several numbers per sample
+(``out_shape``): the result then has the broadcast shape followed by ``out_shape``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+__all__ = ["as_float_array", "broadcast_dense", "broadcast_strided", "evaluate"]
+
+
+def as_float_array(x: Any, name: str) -> np.ndarray:
+    """Convert ``x`` to a float64 array, raising ``ValueError`` that names ``name`` if it cannot."""
+    try:
+        arr = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be numeric, got {x!r}") from exc
+    return arr
+
+
+def broadcast_dense(arr: np.ndarray, shape: tuple[int, ...]) -> np.ndarray | float:
+    """A float if ``arr`` has one element, else a contiguous 1-D array of the broadcast shape."""
+    if arr.size == 1:
+        return float(arr.reshape(-1)[0])
+    if arr.shape == shape and arr.flags.c_contiguous:
+        return arr.reshape(-1)
+    return np.ascontiguousarray(np.broadcast_to(arr, shape)).reshape(-1)
+
+
+def broadcast_strided(arr: np.ndarray, shape: tuple[int, ...]) -> tuple[np.ndarray, int]:
+    """A contiguous 1-D array for ``arr`` broadcast to ``shape`` and its stride: ``(arr, 0)`` for
+    a single value (read as ``arr[i * 0]``, never copied), ``(flat array, 1)`` otherwise."""
+    if arr.size == 1:
+        return np.ascontiguousarray(arr.reshape(1)), 0
+    if arr.shape == shape and arr.flags.c_contiguous:
+        return arr.reshape(-1), 1
+    return np.ascontiguousarray(np.broadcast_to(arr, shape)).reshape(-1), 1
+
+
+def evaluate(
+    drive: Callable,
+    theta_i: np.ndarray,
+    theta_r: np.ndarray,
+    phi: np.ndarray,
+    gamma: np.ndarray,
+    params: tuple,
+    flag: int = 0,
+    out_shape: tuple[int, ...] = (),
+) -> np.ndarray | float:
+    """Run a model's driver ``drive(a, b, c, g, params, flag, out)`` over broadcast arrays.
+
+    The four geometry/polarization inputs are broadcast against each other (NumPy rules). The
+    driver fills ``out`` of shape ``(size, *out_shape)``; the result has the broadcast shape
+    followed by ``out_shape``, or is a Python float if every input was a scalar and
+    ``out_shape`` is ``()``. ``|phi|`` must not exceed
+    :data:`~roughbrdf._kernels.vmath.SINCOS_MAX_ARG` (the model front ends reduce it).
+    """
+    shape = np.broadcast_shapes(theta_i.shape, theta_r.shape, phi.shape, gamma.shape)
+    n = math.prod(shape)
+    out = np.empty((n, *out_shape), dtype=np.float64)
+    if n:
+        p = tuple(float(v) for v in params)
+        drive(broadcast_dense(theta_i, shape), broadcast_dense(theta_r, shape),
+              broadcast_dense(phi, shape), broadcast_dense(gamma, shape), p, int(flag),
+              out if out_shape else out.reshape(n))
+    if not shape and not out_shape:
+        return float(out[0])
+    return out.reshape(*shape, *out_shape)

@@ -1,0 +1,118 @@
+"""What a value means: the :class:`Quantity` type and the one closed-form relative scale.
+
+One type serves measurements, fitting, plotting and model evaluation:
+
+``brdf``
+    The standard BRDF ``f_r`` in sr⁻¹ (reflected radiance / incident irradiance).
+``brdf_cos``
+    ``f_r cos(theta_r)`` (ALTA's ``INV_STERADIAN_COSINE_FACTOR``), finite at the horizon.
+``bridf``
+    TR75's BRIDF, the same number as ``brdf_cos`` under the paper's own name.
+``relative``
+    Proportional to ``f_r`` with an unknown scale. A *model* evaluated as ``relative`` is its
+    BRDF divided by its BRDF at the specular direction of the same incidence (TS67 Eq. 23,
+    ``docs/models.md`` §2.7); *data* marked relative are compared with a model through the
+    closed-form scale of :func:`relative_scale`.
+
+Examples
+--------
+>>> from roughbrdf.quantity import Quantity
+>>> Quantity.parse("BRIDF").cosine_weighted
+True
+>>> Quantity.parse("brdf") == "brdf"
+True
+"""
+
+from __future__ import annotations
+
+import math
+from enum import StrEnum
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+__all__ = ["Quantity", "relative_scale", "LOSSES"]
+
+#: the fit losses :func:`relative_scale` knows (``docs/fitting.md``)
+LOSSES = ("relative", "log", "absolute")
+
+
+class Quantity(StrEnum):
+    """The quantity an array of values holds (a ``str``: compares equal to its name)."""
+
+    BRDF = "brdf"
+    BRDF_COS = "brdf_cos"
+    BRIDF = "bridf"
+    RELATIVE = "relative"
+
+    @classmethod
+    def parse(cls, value: object, name: str = "quantity") -> Quantity:
+        """The quantity named by ``value`` (case-insensitive; ``"brdf*cos"``/``"brdf-cos"``
+        accepted); ``ValueError`` naming ``name`` and the value otherwise."""
+        if isinstance(value, cls):
+            return value
+        key = str(value).strip().lower().replace("-", "_").replace("*", "_").replace(" ", "_")
+        try:
+            return cls(key)
+        except ValueError:
+            raise ValueError(f"{name} must be one of {', '.join(q.value for q in cls)}; "
+                             f"got {value!r}") from None
+
+    @property
+    def cosine_weighted(self) -> bool:
+        """Whether the values carry the factor ``cos(theta_r)`` (``brdf_cos``, ``bridf``)."""
+        return self in (Quantity.BRDF_COS, Quantity.BRIDF)
+
+    @property
+    def absolute(self) -> bool:
+        """Whether the values have an absolute scale (everything but ``relative``)."""
+        return self is not Quantity.RELATIVE
+
+
+def relative_scale(data: ArrayLike, model: ArrayLike, *, weights: ArrayLike | None = None,
+                   loss: str = "relative") -> float:
+    """The closed-form scale ``K`` that puts data of unknown scale onto a model: ``K·data ≈ model``.
+
+    TR75 fits relative measurements by putting the scale on the measured values (Eq. 34,
+    ``docs/fitting.md``); for the loss of the fit, with weights ``w`` and ``q = data/model``:
+
+    * ``relative``: minimizes ``sum(w² (K q - 1)²)``: ``K = sum(w² q)/sum(w² q²)``;
+    * ``absolute``: minimizes ``sum(w² (K data - model)²)``: ``K = sum(w² data model)/sum(w² data²)``;
+    * ``log``: minimizes ``sum(w² (ln K + ln data - ln model)²)``: ``ln K`` is the weighted mean of
+      ``ln model - ln data``.
+
+    Only pairs where both values are finite and the model is positive take part (``log`` also
+    needs positive data). Returns 1.0 where no pair qualifies or the optimum is not a finite
+    positive number.
+
+    Examples
+    --------
+    >>> relative_scale([2.0, 4.0], [1.0, 2.0])
+    0.5
+    >>> relative_scale([2.0, 4.0], [1.0, 2.0], loss="log")
+    0.5
+    """
+    d = np.asarray(data, dtype=np.float64)
+    f = np.asarray(model, dtype=np.float64)
+    d, f = np.broadcast_arrays(d, f)
+    w2 = np.ones(d.shape) if weights is None else np.broadcast_to(
+        np.asarray(weights, dtype=np.float64) ** 2, d.shape)
+    ok = np.isfinite(d) & np.isfinite(f) & (f > 0) & np.isfinite(w2)
+    if loss == "log":
+        ok &= d > 0
+    elif loss not in LOSSES:
+        raise ValueError(f"loss must be one of {', '.join(LOSSES)}; got {loss!r}")
+    if not ok.any():
+        return 1.0
+    d, f, w2 = d[ok], f[ok], w2[ok]
+    if loss == "relative":
+        q = d / f
+        den = float((w2 * q * q).sum())
+        k = float((w2 * q).sum()) / den if den > 0 else 1.0
+    elif loss == "absolute":
+        den = float((w2 * d * d).sum())
+        k = float((w2 * d * f).sum()) / den if den > 0 else 1.0
+    else:
+        wsum = float(w2.sum())
+        k = math.exp(float((w2 * (np.log(f) - np.log(d))).sum()) / wsum) if wsum > 0 else 1.0
+    return k if math.isfinite(k) and k > 0 else 1.0

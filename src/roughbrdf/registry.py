@@ -1,0 +1,102 @@
+"""One registry: names with aliases, looked up case-insensitively, with close-match hints.
+
+Models, facet distributions, shadowing functions and the models' named options all register
+their entries here, so every name a user types is resolved the same way: case and the
+characters ``_``/space are ignored (``"Trowbridge_Reitz"`` is ``"trowbridge-reitz"``), aliases
+map to the canonical entry, and an unknown name raises ``ValueError`` listing the known names
+and the closest matches.
+
+Examples
+--------
+>>> from roughbrdf.registry import Registry
+>>> colours = Registry("colour")
+>>> colours.add("red", 1, aliases=("rouge",))
+1
+>>> colours.get("ROUGE")
+1
+>>> colours.canonical("Rouge")
+'red'
+>>> colours.get("rde")
+Traceback (most recent call last):
+...
+ValueError: unknown colour 'rde'; did you mean 'red'? (known: red)
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Iterable, Iterator
+from typing import Generic, TypeVar
+
+__all__ = ["Registry", "canon", "unknown_name"]
+
+T = TypeVar("T")
+
+
+def canon(name: object) -> str:
+    """The lookup key of a name: stripped, lower case, ``_`` and spaces as ``-``."""
+    return str(name).strip().lower().replace("_", "-").replace(" ", "-")
+
+
+def unknown_name(kind: str, name: object, known: Iterable[str]) -> ValueError:
+    """The ``ValueError`` for an unknown ``name`` of ``kind``, with the closest known names."""
+    known = list(known)
+    close = difflib.get_close_matches(canon(name), [canon(k) for k in known], n=3, cutoff=0.5)
+    by_key = {canon(k): k for k in known}
+    hint = f"; did you mean {', '.join(repr(by_key[c]) for c in close)}?" if close else ""
+    return ValueError(f"unknown {kind} {name!r}{hint} (known: {', '.join(known)})")
+
+
+class Registry(Generic[T]):
+    """Entries of one kind by canonical name and aliases.
+
+    Parameters
+    ----------
+    kind : str
+        What the entries are, for error messages (``"model"``, ``"distribution"``).
+    """
+
+    def __init__(self, kind: str) -> None:
+        self.kind = kind
+        self._entries: dict[str, T] = {}
+        self._names: dict[str, str] = {}  # key (canonical name or alias) -> canonical name
+
+    def add(self, name: str, entry: T, aliases: Iterable[str] = ()) -> T:
+        """Register ``entry`` under ``name`` and ``aliases``; returns ``entry``."""
+        self._entries[name] = entry
+        for key in (name, *aliases):
+            k = canon(key)
+            if self._names.get(k, name) != name:
+                raise ValueError(f"{self.kind} name {key!r} is already taken by "
+                                 f"{self._names[k]!r}")
+            self._names[k] = name
+        return entry
+
+    def canonical(self, name: object) -> str:
+        """The canonical name for ``name`` or one of its aliases."""
+        try:
+            return self._names[canon(name)]
+        except KeyError:
+            raise unknown_name(self.kind, name, self.names()) from None
+
+    def get(self, name: object) -> T:
+        """The entry for ``name`` (case-insensitive; aliases accepted)."""
+        return self._entries[self.canonical(name)]
+
+    def names(self) -> list[str]:
+        """Canonical names, in registration order."""
+        return list(self._entries)
+
+    def aliases(self, name: str) -> list[str]:
+        """The other keys that resolve to ``name``'s entry (lower case)."""
+        target = self.canonical(name)
+        return [k for k, v in self._names.items() if v == target and k != canon(target)]
+
+    def __contains__(self, name: object) -> bool:
+        return canon(name) in self._names
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._entries)
+
+    def __len__(self) -> int:
+        return len(self._entries)

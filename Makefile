@@ -19,14 +19,16 @@ venv: $(STAMP)
 demo: $(STAMP)
 	$(PY) -m roughbrdf.demo --out out
 
+# the suite (tests/), every docstring example in src/ and the README's examples (pyproject.toml)
 test: $(STAMP)
-	$(PY) -m pytest -q -p no:cacheprovider tests
+	$(PY) -m pytest -q -p no:cacheprovider
 
 bench: $(STAMP)
 	$(PY) benchmarks/run.py
 
 lint: $(STAMP)
 	$(PY) -m ruff check src tests benchmarks
+	$(PY) -m mypy
 
 clean:
 	rm -rf out build *.egg-info src/*.egg-info

@@ -343,17 +343,15 @@ def test_fast_and_general_kernels_agree():
     for params, retro_shadowing in itertools.product(
             ({}, dict(FULL, n=4.0, n_r=2.0), dict(FULL, n=0.0, n_r=16.0)), RETRO_SHADOWING):
         m = rb.model("rb08", retro_shadowing=retro_shadowing, **params)
-        p = list(m._pack())
-        assert p[rbm._FAST] == 1.0
+        assert m.uses_fast_kernel
         fast = m.brdf(ti, ts, ph)
-        p[rbm._FAST] = 0.0
-        general = rbm._run(ti, ts, ph, np.full(1, np.nan), tuple(p), 0)
+        general = m.with_general_kernel().brdf(ti, ts, ph)
         np.testing.assert_allclose(fast, general, rtol=1e-13)
         # scalar theta_i (incidence hoisted out of the loop) = the same numbers
         np.testing.assert_allclose(m.brdf(0.7, ts, ph), m.brdf(np.full(5000, 0.7), ts, ph),
                                    rtol=1e-15)
-    assert rb.model("rb08", n=4.5)._pack()[rbm._FAST] == 0.0
-    assert rb.model("rb08", n_r=17.0)._pack()[rbm._FAST] == 0.0
+    assert not rb.model("rb08", n=4.5).uses_fast_kernel
+    assert not rb.model("rb08", n_r=17.0).uses_fast_kernel
 
 
 # ------------------------------------------------------------------------------------------

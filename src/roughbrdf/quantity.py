@@ -77,7 +77,8 @@ def relative_scale(data: ArrayLike, model: ArrayLike, *, weights: ArrayLike | No
     ``docs/fitting.md``); for the loss of the fit, with weights ``w`` and ``q = data/model``:
 
     * ``relative``: minimizes ``sum(w² (K q - 1)²)``: ``K = sum(w² q)/sum(w² q²)``;
-    * ``absolute``: minimizes ``sum(w² (K data - model)²)``: ``K = sum(w² data model)/sum(w² data²)``;
+    * ``absolute``: minimizes ``sum(w² (K data - model)²)``:
+      ``K = sum(w² data model)/sum(w² data²)``;
     * ``log``: minimizes ``sum(w² (ln K + ln data - ln model)²)``: ``ln K`` is the weighted mean of
       ``ln model - ln data``.
 

@@ -19,7 +19,7 @@ Examples
 >>> colours.get("rde")
 Traceback (most recent call last):
 ...
-ValueError: unknown colour 'rde'; did you mean 'red'? (known: red)
+ValueError: unknown colour 'rde'; did you mean 'red', 'rouge'? (known: red)
 """
 
 from __future__ import annotations
@@ -38,11 +38,13 @@ def canon(name: object) -> str:
     return str(name).strip().lower().replace("_", "-").replace(" ", "-")
 
 
-def unknown_name(kind: str, name: object, known: Iterable[str]) -> ValueError:
-    """The ``ValueError`` for an unknown ``name`` of ``kind``, with the closest known names."""
+def unknown_name(kind: str, name: object, known: Iterable[str],
+                 aliases: Iterable[str] = ()) -> ValueError:
+    """The ``ValueError`` for an unknown ``name`` of ``kind``: lists the ``known`` names and
+    suggests the closest of them and of their ``aliases``."""
     known = list(known)
-    close = difflib.get_close_matches(canon(name), [canon(k) for k in known], n=3, cutoff=0.5)
-    by_key = {canon(k): k for k in known}
+    by_key = {canon(k): k for k in (*aliases, *known)}
+    close = difflib.get_close_matches(canon(name), list(by_key), n=3, cutoff=0.5)
     hint = f"; did you mean {', '.join(repr(by_key[c]) for c in close)}?" if close else ""
     return ValueError(f"unknown {kind} {name!r}{hint} (known: {', '.join(known)})")
 
@@ -63,13 +65,13 @@ class Registry(Generic[T]):
 
     def add(self, name: str, entry: T, aliases: Iterable[str] = ()) -> T:
         """Register ``entry`` under ``name`` and ``aliases``; returns ``entry``."""
-        self._entries[name] = entry
-        for key in (name, *aliases):
-            k = canon(key)
-            if self._names.get(k, name) != name:
+        keys = [canon(key) for key in (name, *aliases)]
+        for key, k in zip((name, *aliases), keys, strict=True):
+            if self._names.get(k, name) != name:  # checked first: a refused entry adds nothing
                 raise ValueError(f"{self.kind} name {key!r} is already taken by "
                                  f"{self._names[k]!r}")
-            self._names[k] = name
+        self._entries[name] = entry
+        self._names.update(dict.fromkeys(keys, name))
         return entry
 
     def canonical(self, name: object) -> str:
@@ -77,7 +79,7 @@ class Registry(Generic[T]):
         try:
             return self._names[canon(name)]
         except KeyError:
-            raise unknown_name(self.kind, name, self.names()) from None
+            raise unknown_name(self.kind, name, self.names(), self._names) from None
 
     def get(self, name: object) -> T:
         """The entry for ``name`` (case-insensitive; aliases accepted)."""

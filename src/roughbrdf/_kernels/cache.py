@@ -18,7 +18,7 @@ import functools
 import hashlib
 import os
 
-__all__ = ["install_cache_locators", "locator_installed"]
+__all__ = ["install_cache_locators", "locator_installed", "part_files"]
 
 #: the package root (``src/roughbrdf``): only functions defined below it use these locators
 _PKG_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -27,7 +27,8 @@ _PREFIX = "Roughbrdf"
 
 
 @functools.lru_cache(maxsize=1)
-def _part_files() -> tuple[str, ...]:
+def part_files() -> tuple[str, ...]:
+    """The package's modules (outside ``models/``) that define compiled parts."""
     files = []
     for root, dirs, names in os.walk(_PKG_DIR):
         dirs[:] = [d for d in dirs if d not in ("models", "__pycache__")]
@@ -51,7 +52,7 @@ def _hash_files(stats: tuple) -> str:
 
 def _parts_stamp() -> str:
     stats = []
-    for path in _part_files():
+    for path in part_files():
         st = os.stat(path)
         stats.append((path, st.st_mtime_ns, st.st_size))
     return _hash_files(tuple(stats))
@@ -96,4 +97,6 @@ def install_cache_locators() -> None:
 def locator_installed() -> bool:
     """Whether Numba's locator registry starts with this package's locators."""
     registry = _registry()
-    return bool(registry) and getattr(registry[0], "__name__", "").startswith(_PREFIX)
+    if not registry:
+        return False
+    return getattr(registry[0], "__name__", "").startswith(_PREFIX)

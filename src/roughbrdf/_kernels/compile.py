@@ -41,9 +41,9 @@ from numba.extending import overload
 
 from .cache import install_cache_locators
 
-__all__ = ["DISABLE_JIT", "jit", "ufunc", "driver", "at"]
+__all__ = ["DISABLE_JIT", "LazyUfunc", "jit", "ufunc", "driver", "at"]
 
-DISABLE_JIT: bool = bool(numba.config.DISABLE_JIT)
+DISABLE_JIT: bool = bool(numba.config.DISABLE_JIT)  # type: ignore[attr-defined]
 
 install_cache_locators()
 
@@ -80,7 +80,7 @@ def jit(fn: Callable | None = None, *, inline: bool = False, contract: bool = Tr
 
 
 
-class _LazyUfunc:
+class LazyUfunc:
     """A NumPy ufunc built from a scalar function on its first call (compiled or loaded from the
     disk cache then), so that importing the module that defines it compiles nothing."""
 
@@ -94,6 +94,11 @@ class _LazyUfunc:
             sig = "f8(" + ",".join(["f8"] * self._nargs) + ")"
             self._ufunc = numba.vectorize([sig], cache=True)(self._fn)
         return self._ufunc
+
+    @property
+    def built(self) -> bool:
+        """Whether the ufunc has been compiled (or loaded from the cache) yet."""
+        return self._ufunc is not None
 
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
         return self._build()(*args, **kwargs)
@@ -119,7 +124,7 @@ def ufunc(nargs: int) -> Callable[[Callable], Callable]:
             call.__doc__ = fn.__doc__
             call.__name__ = fn.__name__
             return call
-        return _LazyUfunc(fn, nargs)
+        return LazyUfunc(fn, nargs)
 
     return wrap
 

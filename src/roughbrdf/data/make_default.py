@@ -55,7 +55,7 @@ def make(path: Path = OUT) -> Path:
     ti, tr, ph = geometry.from_tr75(np.radians(beta), np.radians(elev), np.radians(psi))
     tr = np.clip(tr, 0.0, math.pi / 2)
     model = rb.model("trowbridge-reitz-1975", **TRUE)
-    f = model.bridf(ti, tr, ph, polarization=np.radians(gam))
+    f = np.asarray(model.bridf(ti, tr, ph, polarization=np.radians(gam)))
     rng = np.random.default_rng(SEED)
     x = f * (1.0 + NOISE * rng.standard_normal(f.size))
     x /= x[0]  # first row: beta 0, elevation 90, perpendicular

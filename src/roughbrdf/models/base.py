@@ -135,6 +135,10 @@ class Model:
         """``{name: value}`` of the numeric parameters."""
         return dict(self._values)
 
+    def _floats(self) -> dict[str, float]:
+        """The parameters that are set (not ``None``), as floats: what ``_pack`` packs."""
+        return {k: v for k, v in self._values.items() if v is not None}
+
     @property
     def options(self) -> dict[str, Any]:
         """Non-numeric settings (distribution, shadowing, readings)."""

@@ -97,15 +97,16 @@ class Microfacet(Model):
 
     def _validate(self) -> None:
         d = dist.get(self._options["distribution"])
-        dist.check_param(d.code, self._values["alpha"], "alpha")
+        dist.check_param(d.code, self._floats()["alpha"], "alpha")
         n, k = self._values["n"], self._values["k"]
         if n is not None:
             check_index(n, 0.0 if k is None else k)
 
     def _pack(self) -> tuple:
         v = self._values
+        alpha = self._floats()["alpha"]
         d = dist.get(self._options["distribution"])
         use_f = v["n"] is not None
-        return (v["alpha"], v["n"] if use_f else 1.0, (v["k"] or 0.0) if use_f else 0.0,
+        return (alpha, v["n"] if use_f else 1.0, (v["k"] or 0.0) if use_f else 0.0,
                 v["ks"], d.code, shd.get(self._options["shadowing"]),
-                dist.normalization(d.code, v["alpha"]), 1.0 if use_f else 0.0)
+                dist.normalization(d.code, alpha), 1.0 if use_f else 0.0)

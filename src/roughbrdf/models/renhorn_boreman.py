@@ -45,6 +45,7 @@ Both give the same numbers (tested to 1e-13).
 
 from __future__ import annotations
 
+import copy
 import math
 from typing import Any
 
@@ -652,6 +653,8 @@ class RenhornBoreman2008(Model):
     )
     OPTIONS = {"zeta": "angle", "surface_weight": "geometric-mean", "normalization": "literal",
                "polarization": "unpolarized", "retro_shadowing": "width"}
+    #: set by :meth:`with_general_kernel`
+    _force_general: bool = False
     TERMS = ("surface", "bulk", "retro")
     grazing_incidence = False
     reciprocal = False
@@ -661,11 +664,11 @@ class RenhornBoreman2008(Model):
                 for key, val in options.items()}
 
     def _validate(self) -> None:
-        v = self._values
+        v = self._floats()
         check_index(v["n_eff"], v["k_eff"])
 
     def _pack(self, term: int = 0) -> tuple:
-        v = self._values
+        v = self._floats()
         o = self._options
         a_s = 1.0 + v["n"]
         a_r = 1.0 + v["n_r"]
@@ -677,8 +680,22 @@ class RenhornBoreman2008(Model):
                 a_s, a_s / (v["w"] * v["w"]), special.stirlerr(a_s),
                 a_r, a_r / (v["w_r"] * v["w_r"]), special.stirlerr(a_r),
                 1.0 if (v["w_r"], v["n_r"]) == (v["w"], v["n"]) else 0.0,
-                1.0 if (_horner_ok(v["n"]) and _horner_ok(v["n_r"])) else 0.0,
+                1.0 if self.uses_fast_kernel else 0.0,
                 float(RETRO_CODES[o["retro_shadowing"]]))
+
+    @property
+    def uses_fast_kernel(self) -> bool:
+        """Whether evaluation takes the vectorized kernel: integer ``n`` and ``n_r`` up to
+        ``special.INT_HORNER_MAX``, unless made with :meth:`with_general_kernel`."""
+        v = self._floats()
+        return not self._force_general and _horner_ok(v["n"]) and _horner_ok(v["n_r"])
+
+    def with_general_kernel(self) -> RenhornBoreman2008:
+        """A copy that always runs the general kernel (series / continued fraction for V, any
+        real ``n``): the reference the vectorized kernel is checked against (to ~1e-13)."""
+        new = copy.copy(self)
+        new._force_general = True
+        return new
 
     def _kernel(self, g: PreparedGeometry, flag: int, term: str | None
                 ) -> np.ndarray | float:
@@ -688,7 +705,7 @@ class RenhornBoreman2008(Model):
         p = self._pack(TERM_CODES[term])
         ns = nr = None
         if self._options["normalization"] == "numeric":
-            v = self._values
+            v = self._floats()
             ti_arr = np.asarray(ti, dtype=np.float64)
             if term in (None, "surface"):
                 ns = _numeric_n(ti_arr, v["rho"], v["w"], v["n"])

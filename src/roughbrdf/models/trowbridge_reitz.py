@@ -112,9 +112,10 @@ class TrowbridgeReitz1975(Model):
         return {"shadowing": shd.canonical(code)}
 
     def _validate(self) -> None:
-        check_index(self._values["n"], self._values["k"])
+        v = self._floats()
+        check_index(v["n"], v["k"])
 
     def _pack(self) -> tuple:
-        v = self._values
+        v = self._floats()
         return (v["e"], v["n"], v["k"], v["rho_L"],
                 1.0 if self._options["shadowing"] == "v-groove" else 0.0)

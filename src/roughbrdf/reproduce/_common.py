@@ -28,7 +28,7 @@ class Table:
     """A table of numbers: column names and rows (each row a sequence of numbers or strings)."""
 
     columns: list[str]
-    rows: list[Sequence[Any]]
+    rows: Sequence[Sequence[Any]]
 
     def column(self, name: str) -> np.ndarray:
         """One column as an array (floats where possible)."""

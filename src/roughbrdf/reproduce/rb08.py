@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -189,7 +190,8 @@ def fig3(params: dict | None = None, data_dir: str | Path | None = None) -> Repr
     tr, ph = from_signed_angle(np.radians(x))
     fig, axes = new_figure(figsize=(7.5, 5.0))
     ax = axes[0, 0]
-    curves, summary = {}, []
+    curves: dict[float, np.ndarray] = {}
+    summary: list[list[Any]] = []
     cols = incidence_colors(len(INCIDENCES_FIG3))
     for ti, col in zip(INCIDENCES_FIG3, cols, strict=True):
         y = np.asarray(m.brdf(math.radians(ti), tr, ph), dtype=float)

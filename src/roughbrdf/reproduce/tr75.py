@@ -11,6 +11,7 @@ source), converted to the common frame with :func:`roughbrdf.geometry.from_tr75`
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from matplotlib.ticker import MaxNLocator
@@ -146,13 +147,13 @@ def fig6(columns: tuple[tuple[float, float], ...] = FIG6_COLUMNS) -> Reproductio
                            figsize=(3.0 * len(columns), 2.9 * len(surfaces) + 0.4))
     psi_deg = np.arange(0.0, 360.0 + 1e-9, 2.0)
     psi = np.radians(psi_deg)
-    rows = []
+    rows: list[list[Any]] = []
     for i, row in enumerate(surfaces):
         model = surface_model(row)
         for j, (beta, elev) in enumerate(columns):
             ax = axes[i, j]
             plot_polar(model, math.radians(beta), math.radians(elev), n=psi.size,
-                       label=row["surface"], ax=ax)
+                       label=str(row["surface"]), ax=ax)
             ax.set_title(f"{row['surface']}\nβ = {beta:g}°, θ = {elev:g}° elev.",
                          fontsize="small")
             ax.tick_params(labelsize="x-small", pad=1)

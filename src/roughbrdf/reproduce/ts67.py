@@ -11,6 +11,7 @@ signed θ: positive for φ = 0, negative for φ = 180° (TS67 text under Fig. 2)
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -83,7 +84,8 @@ def _signed_axis(step: float = 0.1, limit: float = 89.9) -> np.ndarray:
 
 def _relative_signed(model: rb.Model, psi_deg: float, theta_signed_deg: np.ndarray) -> np.ndarray:
     tr, ph = from_signed_angle(np.radians(theta_signed_deg))
-    return np.asarray(model.relative(math.radians(psi_deg), tr, ph), dtype=float)
+    return np.asarray(model.evaluate(math.radians(psi_deg), tr, ph, quantity="relative"),
+                      dtype=float)
 
 
 def _g_over_cos_signed(psi_deg: float, theta_signed_deg: np.ndarray) -> np.ndarray:
@@ -183,9 +185,9 @@ def fig9(constants: dict | None = None) -> Reproduction:
     x = _signed_axis()
     fig, axes = new_figure(1, 2, figsize=(12.0, 4.8), sharey=True)
     tables = {}
-    gf_rows = []
+    gf_rows: list[list[Any]] = []
     for ax, (name, letter) in zip(axes[0], (("aluminium", "a"), ("MgO", "b")), strict=True):
-        cst = consts[name]
+        cst: dict[str, Any] = consts[name]
         model = relative_model(g=cst["g"], n=cst["n"], k=cst["k"])
         curves = _relative_family(
             ax, model, PSI_FIG8, x,
@@ -214,7 +216,7 @@ def fig9(constants: dict | None = None) -> Reproduction:
 def _phi_family(values, ylabel: str, title: str, ylims, logs=(False, False, False)) -> tuple:
     theta = np.unique(np.append(np.arange(0.0, 89.9, 0.25), 89.9))
     fig, axes = new_figure(1, 3, figsize=(15.0, 4.6))
-    rows = []
+    rows: list[list[float]] = []
     for ax, psi, letter, ylim, log in zip(axes[0], PSI_OUT_OF_PLANE, "abc", ylims, logs,
                                           strict=True):
         for phi, col in zip(PHI_FAMILY, incidence_colors(len(PHI_FAMILY), "plasma"),
@@ -265,8 +267,9 @@ def fig11() -> Reproduction:
     model = relative_model()
 
     def rel(psi: float, theta_deg: np.ndarray, phi_deg: float) -> np.ndarray:
-        return np.asarray(model.relative(math.radians(psi), np.radians(theta_deg),
-                                         math.radians(phi_deg)), dtype=float)
+        return np.asarray(model.evaluate(math.radians(psi), np.radians(theta_deg),
+                                         math.radians(phi_deg), quantity="relative"),
+                          dtype=float)
 
     fig, rows = _phi_family(rel, r"$\rho(\psi;\theta,\phi)/\rho(\psi;\psi,0)$",
                             "TS67 Fig. 11: Eq. 23 for various azimuths φ "

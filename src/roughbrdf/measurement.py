@@ -15,14 +15,15 @@ from typing import Any
 import numpy as np
 
 from .geometry import check_angles
+from .quantity import Quantity
 
 __all__ = ["Measurement", "QUANTITIES"]
 
-#: What a measurement's values hold.
+#: What a measurement's values hold: the names of :class:`~roughbrdf.quantity.Quantity`.
 #: ``brdf`` f_r (sr⁻¹); ``brdf_cos`` f_r cos(theta_r) (ALTA INV_STERADIAN_COSINE_FACTOR);
 #: ``bridf`` TR75's BRIDF (identical to brdf_cos, kept as its own name); ``relative`` any
 #: quantity proportional to f_r with an unknown scale (TR75's relative BRIDF is relative x cos).
-QUANTITIES = ("brdf", "brdf_cos", "bridf", "relative")
+QUANTITIES = tuple(q.value for q in Quantity)
 
 #: provenance keys that every reader fills in ``meta`` (None when the file does not say)
 PROVENANCE = ("file", "format", "sample", "instrument", "date")
@@ -40,8 +41,11 @@ class Measurement:
         One column per channel.
     channels : list of str
         Channel labels (e.g. ``"465nm"``); ``len(channels) == C``.
-    quantity : str
-        One of :data:`QUANTITIES`.
+    quantity : Quantity
+        What the values hold; given as a :class:`~roughbrdf.quantity.Quantity` or any name
+        :meth:`Quantity.parse <roughbrdf.quantity.Quantity.parse>` accepts (one of
+        :data:`QUANTITIES`), stored as a ``Quantity`` (a ``str``: ``m.quantity == "brdf"``
+        works, and it is written as its plain name), also when assigned later.
     polarization : numpy.ndarray, shape (N,), optional
         Per-sample incident polarization angle gamma (radians; NaN = unpolarized).
     uncertainty : numpy.ndarray, shape (N, C), optional
@@ -59,7 +63,7 @@ class Measurement:
     phi: np.ndarray
     values: np.ndarray
     channels: list[str] = field(default_factory=lambda: ["value"])
-    quantity: str = "brdf"
+    quantity: Quantity = Quantity.BRDF
     polarization: np.ndarray | None = None
     uncertainty: np.ndarray | None = None
     original: dict[str, np.ndarray] = field(default_factory=dict)
@@ -88,8 +92,10 @@ class Measurement:
                              f"columns{where}")
         if len(set(self.channels)) != len(self.channels):
             raise ValueError(f"channel labels must be distinct, got {self.channels}{where}")
-        if self.quantity not in QUANTITIES:
-            raise ValueError(f"quantity must be one of {QUANTITIES}, got {self.quantity!r}{where}")
+        try:
+            self.quantity = Quantity.parse(self.quantity, "quantity")
+        except ValueError as exc:
+            raise ValueError(f"{exc}{where}") from None
         try:
             check_angles(self.theta_i, self.theta_r, self.phi)
         except ValueError as exc:
@@ -110,6 +116,13 @@ class Measurement:
             orig[str(k)] = a
         self.original = orig
         self.meta = dict(self.meta or {})
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        # once constructed (meta is the last field set by __init__), an assigned quantity is
+        # parsed too, so that m.quantity is always a Quantity
+        if name == "quantity" and "meta" in self.__dict__:
+            value = Quantity.parse(value, "quantity")
+        object.__setattr__(self, name, value)
 
     def __repr__(self) -> str:
         return (f"<Measurement {self.n_samples} samples x {len(self.channels)} channels "
@@ -294,38 +307,41 @@ class Measurement:
     # quantities
     # ------------------------------------------------------------------------------------------
     def to_brdf(self) -> np.ndarray:
-        """Values converted to BRDF (sr⁻¹) where the quantity allows it (brdf_cos/bridf / cos)."""
-        if self.quantity == "brdf":
-            return self.values
-        if self.quantity in ("brdf_cos", "bridf"):
-            c = np.cos(self.theta_r)[:, None]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                return self.values / c
-        raise ValueError("a 'relative' measurement has no absolute BRDF scale")
+        """Values converted to BRDF (sr⁻¹) where the quantity allows it (cosine-weighted
+        quantities, ``brdf_cos``/``bridf``, are divided by cos(theta_r)).
 
-    def as_quantity(self, quantity: str) -> Measurement:
+        Raises ``ValueError`` for a ``relative`` measurement (no absolute scale).
+        """
+        if not self.quantity.absolute:
+            raise ValueError("a 'relative' measurement has no absolute BRDF scale")
+        if not self.quantity.cosine_weighted:
+            return self.values
+        c = np.cos(self.theta_r)[:, None]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return self.values / c
+
+    def as_quantity(self, quantity: Quantity | str) -> Measurement:
         """The same samples holding ``quantity`` (``brdf`` <-> ``brdf_cos``/``bridf``).
 
         Uncertainties are scaled with the values. ``relative`` converts to nothing else; anything
-        converts to ``relative`` only by relabelling (the values are kept).
+        converts to ``relative`` only by relabelling (the values are kept). ``ValueError`` for a
+        name that is not a quantity.
         """
-        if quantity not in QUANTITIES:
-            raise ValueError(f"quantity must be one of {QUANTITIES}, got {quantity!r}")
-        if quantity == self.quantity:
+        target = Quantity.parse(quantity, "quantity")
+        if target == self.quantity:
             return replace(self, meta=dict(self.meta))
-        if quantity == "relative":
-            return replace(self, quantity="relative", meta=dict(self.meta))
-        if self.quantity == "relative":
+        if not target.absolute:
+            return replace(self, quantity=target, meta=dict(self.meta))
+        if not self.quantity.absolute:
             raise ValueError("a 'relative' measurement has no absolute scale; cannot convert it "
-                             f"to {quantity!r}")
-        cos_family = ("brdf_cos", "bridf")
-        if self.quantity in cos_family and quantity in cos_family:
+                             f"to {target.value!r}")
+        if self.quantity.cosine_weighted == target.cosine_weighted:
             factor = np.ones((self.n_samples, 1))
         else:
             c = np.cos(self.theta_r)[:, None]
             with np.errstate(divide="ignore", invalid="ignore"):
-                factor = c if quantity in cos_family else 1.0 / c
-        return replace(self, values=self.values * factor, quantity=quantity,
+                factor = c if target.cosine_weighted else 1.0 / c
+        return replace(self, values=self.values * factor, quantity=target,
                        uncertainty=None if self.uncertainty is None
                        else self.uncertainty * np.abs(factor), meta=dict(self.meta))
 

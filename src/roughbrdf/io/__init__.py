@@ -13,6 +13,13 @@ csv       ``.csv``              :mod:`roughbrdf.io.csv` (roughbrdf CSV)         
 extension is unknown it looks at the first bytes. Every problem with a file raises
 :class:`FormatError` (a ``ValueError``) whose message starts with the path and, where one line is
 at fault, the line number (also in ``.path`` and ``.line``).
+
+Each text reader's ``read()`` runs the same phases - header, angle unit, columns, quantity,
+rows - and every reader applies the same two rules, from :mod:`roughbrdf.io._common`: the angle
+unit (``angles=`` option, else the file's declarations, else the format's default or an error
+where a declaration is required) and the quantity (``quantity=`` option, else the file's
+declaration, else the format's default or an error), as a
+:class:`~roughbrdf.quantity.Quantity`.
 """
 
 from __future__ import annotations

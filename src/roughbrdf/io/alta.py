@@ -42,21 +42,28 @@ from __future__ import annotations
 import math
 import os
 import shlex
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..geometry import from_rusinkiewicz
 from ..measurement import QUANTITIES, Measurement
+from ..quantity import Quantity
 from ._common import (
     HALF_PI,
     ZENITH_SLACK,
+    AngleUnit,
     FormatError,
+    QuantityClaim,
     azimuth_rows,
     begin_read,
     check_zenith_rows,
     common_frame_from_spherical,
     parse_rows,
+    resolve_angle_unit,
+    resolve_quantity,
 )
 
 __all__ = ["read", "write", "EXTENSIONS", "PARAM_IN"]
@@ -66,9 +73,46 @@ EXTENSIONS = (".dat", ".alta")
 #: supported input parametrizations and their dimension
 PARAM_IN = {"ISOTROPIC_TL_TV_PROJ_DPHI": 3, "ISOTROPIC_TV_TL_DPHI": 3,
             "SPHERICAL_TL_PL_TV_PV": 4, "RUSIN_TH_TD_PD": 3}
-_PARAM_OUT = {"INV_STERADIAN": "brdf", "INV_STERADIAN_COSINE_FACTOR": "brdf_cos"}
-_QUANTITY_OUT = {"brdf": "INV_STERADIAN", "brdf_cos": "INV_STERADIAN_COSINE_FACTOR",
-                 "bridf": "INV_STERADIAN_COSINE_FACTOR"}
+#: #PARAM_OUT -> quantity
+_PARAM_OUT = {"INV_STERADIAN": Quantity.BRDF,
+              "INV_STERADIAN_COSINE_FACTOR": Quantity.BRDF_COS}
+_MISSING_PARAM_OUT = ("no #PARAM_OUT line, so the unit of the values is unknown: say what they "
+                      "hold with quantity= (CLI: --quantity): 'brdf' (INV_STERADIAN) or "
+                      "'brdf_cos' (INV_STERADIAN_COSINE_FACTOR, BRDF x cos theta_v)")
+
+
+@dataclass
+class _Header:
+    """The ``#KEY value`` lines (keys upper-cased) and the data rows between them."""
+
+    keys: dict[str, str]
+    lines: dict[str, int]
+    #: data rows (stripped) and their 1-based line numbers
+    texts: list[str]
+    linenos: list[int]
+
+    def line(self, key: str) -> int | None:
+        """1-based line of ``#key`` (None when absent)."""
+        return self.lines.get(key)
+
+    def first_word(self, key: str) -> str:
+        """The first word of ``#key``'s value ("" when absent or empty)."""
+        return self.keys.get(key, "").split()[0] if self.keys.get(key) else ""
+
+
+@dataclass(frozen=True)
+class _Layout:
+    """What a row holds: ``nin`` inputs (``#PARAM_IN``), ``nout`` outputs, confidence ``vs``."""
+
+    param_in: str
+    nin: int
+    nout: int
+    vs: int
+
+    @property
+    def per_row(self) -> int:
+        """Numbers per row."""
+        return self.nin + self.nout * (1 + self.vs)
 
 
 def _unquote(text: str) -> str:
@@ -79,18 +123,14 @@ def _unquote(text: str) -> str:
     return " ".join(parts)
 
 
-def read(path: str | os.PathLike, *, quantity: str | None = None, **options: Any) -> Measurement:
-    """Read an ALTA text file into a :class:`~roughbrdf.measurement.Measurement`.
-
-    Parameters
-    ----------
-    quantity : str, optional
-        What the values hold when the file has no ``#PARAM_OUT`` (or to state it explicitly;
-        it must then agree with the file's declaration).
-    """
-    path, lines = begin_read("alta", path, options, quantity)
-    header: dict[str, str] = {}
-    hline: dict[str, int] = {}
+# --------------------------------------------------------------------------------------------
+# phases of read()
+# --------------------------------------------------------------------------------------------
+def _read_header(lines: list[str]) -> _Header:
+    """Header phase: every ``#KEY value`` line (anywhere in the file; a later one replaces an
+    earlier one) and, apart, every other non-blank line as a data row."""
+    keys: dict[str, str] = {}
+    key_lines: dict[str, int] = {}
     texts: list[str] = []
     linenos: list[int] = []
     for i, raw in enumerate(lines):
@@ -100,82 +140,90 @@ def read(path: str | os.PathLike, *, quantity: str | None = None, **options: Any
         if s.startswith("#"):
             key, _, val = s[1:].strip().partition(" ")
             if key:
-                header[key.upper()] = val.strip()
-                hline[key.upper()] = i + 1
+                keys[key.upper()] = val.strip()
+                key_lines[key.upper()] = i + 1
             continue
         texts.append(s)
         linenos.append(i + 1)
+    return _Header(keys, key_lines, texts, linenos)
 
-    if "DIM" not in header:
+
+def _read_vs(header: _Header, path: Path) -> int:
+    """``#VS``: the confidence-interval kind, 0 (none, also when absent), 1 or 2."""
+    if "VS" not in header.keys:
+        return 0
+    try:
+        vs = int(header.keys["VS"].split()[0])
+    except (ValueError, IndexError):
+        raise FormatError(f"#VS must be 0, 1 or 2, got {header.keys['VS']!r}", path,
+                          header.line("VS")) from None
+    if vs not in (0, 1, 2):
+        raise FormatError(f"#VS must be 0, 1 or 2, got {vs}", path, header.line("VS"))
+    return vs
+
+
+def _read_layout(header: _Header, path: Path) -> _Layout:
+    """Columns phase: ``#DIM nin nout`` (required), ``#PARAM_IN`` (required, one of
+    :data:`PARAM_IN`, with ``nin`` inputs) and ``#VS``."""
+    if "DIM" not in header.keys:
         raise FormatError("no #DIM line (e.g. '#DIM 3 1'); this does not look like an ALTA "
                           "data file", path, 1)
     try:
-        nin, nout = (int(t) for t in header["DIM"].split()[:2])
+        nin, nout = (int(t) for t in header.keys["DIM"].split()[:2])
     except ValueError:
-        raise FormatError(f"#DIM must hold two integers, got {header['DIM']!r}", path,
-                          hline["DIM"]) from None
-    pin = header.get("PARAM_IN", "").split()[0] if header.get("PARAM_IN") else ""
+        raise FormatError(f"#DIM must hold two integers, got {header.keys['DIM']!r}", path,
+                          header.line("DIM")) from None
+    pin = header.first_word("PARAM_IN")
     if not pin:
         raise FormatError("no #PARAM_IN line: the angle parametrization is unknown "
-                          f"(supported: {', '.join(PARAM_IN)})", path, hline["DIM"])
+                          f"(supported: {', '.join(PARAM_IN)})", path, header.line("DIM"))
     if pin not in PARAM_IN:
         raise FormatError(f"#PARAM_IN {pin} is not supported (supported: "
-                          f"{', '.join(PARAM_IN)})", path, hline["PARAM_IN"])
+                          f"{', '.join(PARAM_IN)})", path, header.line("PARAM_IN"))
     if PARAM_IN[pin] != nin:
         raise FormatError(f"#PARAM_IN {pin} has {PARAM_IN[pin]} inputs but #DIM says {nin}",
-                          path, hline["DIM"])
+                          path, header.line("DIM"))
     if nout < 1:
-        raise FormatError(f"#DIM declares {nout} outputs", path, hline["DIM"])
-    vs = 0
-    if "VS" in header:
-        try:
-            vs = int(header["VS"].split()[0])
-        except (ValueError, IndexError):
-            raise FormatError(f"#VS must be 0, 1 or 2, got {header['VS']!r}", path,
-                              hline["VS"]) from None
-        if vs not in (0, 1, 2):
-            raise FormatError(f"#VS must be 0, 1 or 2, got {vs}", path, hline["VS"])
+        raise FormatError(f"#DIM declares {nout} outputs", path, header.line("DIM"))
+    return _Layout(pin, nin, nout, _read_vs(header, path))
 
-    # --- quantity ---------------------------------------------------------------------------
-    pout = header.get("PARAM_OUT", "").split()[0] if header.get("PARAM_OUT") else ""
-    declared = _PARAM_OUT.get(pout)
-    if pout and declared is None and quantity is None:
-        raise FormatError(f"#PARAM_OUT {pout} is not a BRDF unit (INV_STERADIAN or "
-                          "INV_STERADIAN_COSINE_FACTOR); say what the values hold with "
-                          f"quantity= (CLI: --quantity), one of {QUANTITIES}", path,
-                          hline["PARAM_OUT"])
-    if not pout and quantity is None:
-        raise FormatError("no #PARAM_OUT line, so the unit of the values is unknown: say what "
-                          "they hold with quantity= (CLI: --quantity): 'brdf' (INV_STERADIAN) "
-                          "or 'brdf_cos' (INV_STERADIAN_COSINE_FACTOR, BRDF x cos theta_v)",
-                          path, None)
-    if quantity is not None and declared is not None:
-        same = {quantity, declared} <= {"brdf_cos", "bridf"} or quantity == declared
-        if not same:
-            raise FormatError(f"quantity={quantity!r} contradicts #PARAM_OUT {pout} "
-                              f"({declared})", path, hline["PARAM_OUT"])
-    q = quantity or declared
-    assert q is not None
 
-    # --- rows -------------------------------------------------------------------------------
-    if not texts:
-        raise FormatError("no data rows after the header", path, len(lines) + 1)
-    per_row = nin + nout * (1 + vs)
-    data = parse_rows(texts, linenos, per_row, path, sep=None,
+def _read_quantity(header: _Header, quantity: str | None, path: Path) -> tuple[Quantity, str]:
+    """Quantity phase: ``#PARAM_OUT`` (INV_STERADIAN -> brdf, INV_STERADIAN_COSINE_FACTOR ->
+    brdf_cos) and the ``quantity=`` option, which must agree with it (brdf_cos and bridf agree);
+    without a BRDF ``#PARAM_OUT`` the option is required. Returns the quantity and its source."""
+    pout = header.first_word("PARAM_OUT")
+    claims = []
+    if pout:
+        claims.append(QuantityClaim(
+            _PARAM_OUT.get(pout), f"#PARAM_OUT {pout}", header.line("PARAM_OUT"),
+            problem=f"#PARAM_OUT {pout} is not a BRDF unit (INV_STERADIAN or "
+                    "INV_STERADIAN_COSINE_FACTOR); say what the values hold with quantity= "
+                    f"(CLI: --quantity), one of {QUANTITIES}"))
+    return resolve_quantity(quantity, claims, path, agree=True, missing=_MISSING_PARAM_OUT)
+
+
+def _read_rows(header: _Header, layout: _Layout, n_lines: int, path: Path
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """Rows phase: ``nin`` inputs (finite), ``nout`` values and, per ``#VS``, a half-width (1)
+    or lower and upper bounds (2) per value; a ``#SAMPLE_COUNT`` above the row count is a
+    truncated file. Returns inputs, values and uncertainty (half-widths)."""
+    if not header.texts:
+        raise FormatError("no data rows after the header", path, n_lines + 1)
+    nin, nout, vs = layout.nin, layout.nout, layout.vs
+    data = parse_rows(header.texts, header.linenos, layout.per_row, path, sep=None,
                       what=f"values (#DIM {nin} {nout}, #VS {vs})")
-    ln = np.asarray(linenos)
-    if "SAMPLE_COUNT" in header:
+    if "SAMPLE_COUNT" in header.keys:
         try:
-            declared_n = int(header["SAMPLE_COUNT"].split()[0])
+            declared_n = int(header.keys["SAMPLE_COUNT"].split()[0])
         except ValueError:
             declared_n = None
         if declared_n is not None and declared_n > data.shape[0]:
             raise FormatError(f"truncated file: #SAMPLE_COUNT is {declared_n} but only "
-                              f"{data.shape[0]} rows follow", path, len(lines) + 1)
+                              f"{data.shape[0]} rows follow", path, n_lines + 1)
     x = data[:, :nin]
     for j in range(nin):
-        azimuth_rows(x[:, j], f"x{j}", ln, path)  # angles must be finite (names the line)
-    values = data[:, nin:nin + nout]
+        azimuth_rows(x[:, j], f"x{j}", header.linenos, path)  # finite, else names the line
     uncertainty = None
     if vs == 1:
         uncertainty = np.abs(data[:, nin + nout:nin + 2 * nout])
@@ -183,60 +231,115 @@ def read(path: str | os.PathLike, *, quantity: str | None = None, **options: Any
         lo = data[:, nin + nout:nin + 3 * nout:2]
         hi = data[:, nin + nout + 1:nin + 3 * nout:2]
         uncertainty = 0.5 * np.abs(hi - lo)
+    return x, data[:, nin:nin + nout], uncertainty
 
-    # --- geometry ---------------------------------------------------------------------------
-    original = {f"x{j}": x[:, j].copy() for j in range(nin)}
-    if pin == "ISOTROPIC_TL_TV_PROJ_DPHI":
-        tl = check_zenith_rows(x[:, 0], "theta_l (x0)", ln, path)
-        tv_raw = np.hypot(x[:, 1], x[:, 2])
-        tv = check_zenith_rows(tv_raw, "theta_v = hypot(x1, x2)", ln, path)
-        dphi = np.arctan2(x[:, 2], x[:, 1])
-        theta_i, theta_r, phi = common_frame_from_spherical(tl, np.zeros_like(tl), tv, dphi)
-    elif pin == "ISOTROPIC_TV_TL_DPHI":
-        tv = check_zenith_rows(x[:, 0], "theta_v (x0)", ln, path)
-        tl = check_zenith_rows(x[:, 1], "theta_l (x1)", ln, path)
-        theta_i, theta_r, phi = common_frame_from_spherical(tl, x[:, 2], tv, np.zeros_like(tv))
-    elif pin == "SPHERICAL_TL_PL_TV_PV":
-        tl = check_zenith_rows(x[:, 0], "theta_l (x0)", ln, path)
-        tv = check_zenith_rows(x[:, 2], "theta_v (x2)", ln, path)
-        theta_i, theta_r, phi = common_frame_from_spherical(tl, x[:, 1], tv, x[:, 3])
-    else:  # RUSIN_TH_TD_PD
-        theta_i, theta_r, phi = from_rusinkiewicz(x[:, 0], x[:, 1], x[:, 2])
-        below = ~np.isfinite(theta_i)
-        if below.any():
-            k = int(np.flatnonzero(below)[0])
-            raise FormatError(f"(theta_h, theta_d, phi_d) = {tuple(x[k])} puts a direction "
-                              f"below the horizon ({int(below.sum())} such rows)", path,
-                              int(ln[k]))
-        theta_i = np.clip(theta_i, 0.0, HALF_PI)
-        theta_r = np.clip(theta_r, 0.0, HALF_PI)
 
-    channels = ["value"] if nout == 1 else [f"c{j}" for j in range(nout)]
-    if header.get("CHANNELS"):  # written by roughbrdf: one label per output
-        labels = header["CHANNELS"].split()
-        if len(labels) != nout:
-            raise FormatError(f"#CHANNELS lists {len(labels)} labels for {nout} outputs", path,
-                              hline["CHANNELS"])
-        channels = labels
-    sample = _unquote(header["SAMPLE"]) if header.get("SAMPLE") else None
-    meta: dict[str, Any] = {
+def _tl_tv_proj_dphi(x, ln, path, unit):
+    """``(theta_l, theta_v cos dphi, theta_v sin dphi)``."""
+    tl = check_zenith_rows(x[:, 0], "theta_l (x0)", ln, path, unit=unit)
+    tv = check_zenith_rows(np.hypot(x[:, 1], x[:, 2]), "theta_v = hypot(x1, x2)", ln, path,
+                           unit=unit)
+    return common_frame_from_spherical(tl, np.zeros_like(tl), tv, np.arctan2(x[:, 2], x[:, 1]))
+
+
+def _tv_tl_dphi(x, ln, path, unit):
+    """``(theta_v, theta_l, dphi)``."""
+    tv = check_zenith_rows(x[:, 0], "theta_v (x0)", ln, path, unit=unit)
+    tl = check_zenith_rows(x[:, 1], "theta_l (x1)", ln, path, unit=unit)
+    return common_frame_from_spherical(tl, x[:, 2], tv, np.zeros_like(tv))
+
+
+def _tl_pl_tv_pv(x, ln, path, unit):
+    """``(theta_l, phi_l, theta_v, phi_v)``."""
+    tl = check_zenith_rows(x[:, 0], "theta_l (x0)", ln, path, unit=unit)
+    tv = check_zenith_rows(x[:, 2], "theta_v (x2)", ln, path, unit=unit)
+    return common_frame_from_spherical(tl, x[:, 1], tv, x[:, 3])
+
+
+def _rusin_th_td_pd(x, ln, path, unit):
+    """Rusinkiewicz ``(theta_h, theta_d, phi_d)``; a direction below the horizon is an error."""
+    theta_i, theta_r, phi = from_rusinkiewicz(x[:, 0], x[:, 1], x[:, 2])
+    below = ~np.isfinite(theta_i)
+    if below.any():
+        k = int(np.flatnonzero(below)[0])
+        raise FormatError(f"(theta_h, theta_d, phi_d) = {tuple(x[k])} puts a direction below "
+                          f"the horizon ({int(below.sum())} such rows)", path, int(ln[k]))
+    return np.clip(theta_i, 0.0, HALF_PI), np.clip(theta_r, 0.0, HALF_PI), phi
+
+
+#: #PARAM_IN -> (inputs, line numbers, path, unit) -> common-frame (theta_i, theta_r, phi)
+_GEOMETRY = {"ISOTROPIC_TL_TV_PROJ_DPHI": _tl_tv_proj_dphi, "ISOTROPIC_TV_TL_DPHI": _tv_tl_dphi,
+             "SPHERICAL_TL_PL_TV_PV": _tl_pl_tv_pv, "RUSIN_TH_TD_PD": _rusin_th_td_pd}
+
+
+def _read_channels(header: _Header, nout: int, path: Path) -> list[str]:
+    """Channel labels: ``#CHANNELS`` (written by roughbrdf, one label per output), else
+    ``value`` for one output and ``c0, c1, ...`` for several."""
+    if not header.keys.get("CHANNELS"):
+        return ["value"] if nout == 1 else [f"c{j}" for j in range(nout)]
+    labels = header.keys["CHANNELS"].split()
+    if len(labels) != nout:
+        raise FormatError(f"#CHANNELS lists {len(labels)} labels for {nout} outputs", path,
+                          header.line("CHANNELS"))
+    return labels
+
+
+def _meta(header: _Header, path: Path, layout: _Layout, quantity_source: str,
+          unit: AngleUnit) -> dict[str, Any]:
+    """Provenance: ``#SAMPLE``, ``#ORIGIN`` (instrument), ``#DATE`` (quotes removed), ``#URL``,
+    the parametrizations, the raw header."""
+    keys = header.keys
+
+    def unquoted(key: str) -> str | None:
+        return _unquote(keys[key]) if keys.get(key) else None
+
+    return {
         "file": str(path),
         "format": "alta",
-        "sample": sample,
-        "instrument": _unquote(header["ORIGIN"]) if header.get("ORIGIN") else None,
-        "date": _unquote(header["DATE"]) if header.get("DATE") else None,
-        "url": header.get("URL"),
-        "param_in": pin,
-        "param_out": pout or None,
-        "quantity_source": f"#PARAM_OUT {pout}" if declared else "option quantity=",
-        "vs": vs,
-        "original_units": "rad",
+        "sample": unquoted("SAMPLE"),
+        "instrument": unquoted("ORIGIN"),
+        "date": unquoted("DATE"),
+        "url": keys.get("URL"),
+        "param_in": layout.param_in,
+        "param_out": header.first_word("PARAM_OUT") or None,
+        "quantity_source": quantity_source,
+        "vs": layout.vs,
+        "original_units": unit.word,
         "zenith_clip_tolerance": ZENITH_SLACK,
-        "header": dict(header),
+        "header": dict(keys),
     }
+
+
+def read(path: str | os.PathLike, *, quantity: str | None = None, **options: Any) -> Measurement:
+    """Read an ALTA text file into a :class:`~roughbrdf.measurement.Measurement`.
+
+    Parameters
+    ----------
+    path : str or path-like
+    quantity : str, optional
+        What the values hold when the file has no ``#PARAM_OUT`` (or to state it explicitly;
+        it must then agree with the file's declaration).
+
+    Raises
+    ------
+    FormatError
+        For anything the file gets wrong, naming the file and, where one line is at fault, the
+        line.
+    """
+    path, lines = begin_read("alta", path, options, quantity)
+    header = _read_header(lines)
+    layout = _read_layout(header, path)
+    # ALTA has no unit declaration: its angles are radians
+    unit = resolve_angle_unit(None, (), path, default="rad", default_source="ALTA (radians)")
+    q, quantity_source = _read_quantity(header, quantity, path)
+    x, values, uncertainty = _read_rows(header, layout, len(lines), path)
+    theta_i, theta_r, phi = _GEOMETRY[layout.param_in](x, np.asarray(header.linenos), path,
+                                                      unit.word)
     return Measurement(theta_i=theta_i, theta_r=theta_r, phi=phi, values=values,
-                       channels=channels, quantity=q, uncertainty=uncertainty,
-                       original=original, meta=meta)
+                       channels=_read_channels(header, layout.nout, path), quantity=q,
+                       uncertainty=uncertainty,
+                       original={f"x{j}": x[:, j].copy() for j in range(layout.nin)},
+                       meta=_meta(header, path, layout, quantity_source, unit))
 
 
 def write(measurement: Measurement, path: str | os.PathLike) -> None:
@@ -248,9 +351,10 @@ def write(measurement: Measurement, path: str | os.PathLike) -> None:
     Per-sample polarization cannot be stored in ALTA and is refused unless all unpolarized.
     """
     m = measurement
-    if m.quantity not in _QUANTITY_OUT:
+    quantity = Quantity.parse(m.quantity)
+    if not quantity.absolute:
         raise ValueError(f"ALTA files hold INV_STERADIAN or INV_STERADIAN_COSINE_FACTOR; a "
-                         f"{m.quantity!r} measurement cannot be written (use CSV)")
+                         f"{quantity.value!r} measurement cannot be written (use CSV)")
     if m.polarization is not None and np.isfinite(m.polarization).any():
         raise ValueError("ALTA files cannot hold per-sample polarization; write CSV, or select "
                          "one polarization (Measurement.with_polarization) and drop it")
@@ -272,7 +376,8 @@ def write(measurement: Measurement, path: str | os.PathLike) -> None:
     if m.meta.get("date"):
         lines.append(f'#DATE "{m.meta["date"]}"')
     lines += [f"#DIM 3 {m.n_channels}", f"#VS {vs}", "#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI",
-              f"#PARAM_OUT {_QUANTITY_OUT[m.quantity]}"]
+              "#PARAM_OUT " + ("INV_STERADIAN_COSINE_FACTOR" if quantity.cosine_weighted
+                               else "INV_STERADIAN")]
     if m.n_channels > 1:
         lines.append("#CHANNELS " + " ".join(m.channels))
     with open(path, "w", encoding="utf-8", newline="\n") as fh:

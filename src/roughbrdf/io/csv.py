@@ -44,19 +44,28 @@ from __future__ import annotations
 import math
 import os
 import re
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..fresnel import polarization_angle
 from ..measurement import QUANTITIES, Measurement
+from ..quantity import Quantity
 from ._common import (
+    AngleUnit,
     FormatError,
+    QuantityClaim,
+    UnitClaim,
     angle_factor,
     azimuth_rows,
     begin_read,
     check_zenith_rows,
+    data_lines,
     parse_rows,
+    resolve_angle_unit,
+    resolve_quantity,
 )
 
 __all__ = ["read", "write", "EXTENSIONS", "TAG"]
@@ -66,48 +75,93 @@ TAG = "roughbrdf-csv"
 VERSION = 1
 _ANGLES = ("theta_i", "theta_r", "phi")
 _SUFFIX = re.compile(r"^(theta_i|theta_r|phi|polarization)_(deg|rad)$")
+#: header keys that declare the angle unit, first found wins
+_UNIT_KEYS = ("angles", "angle_units", "units")
+_MISSING_UNITS = ("missing angle units: add a header line '# angles: deg' or '# angles: rad' "
+                  "before the column names (or name the columns theta_i_deg, ...; or pass "
+                  "angles=)")
+_MISSING_QUANTITY = ("missing quantity: add a header line '# quantity: brdf' (or brdf_cos, "
+                     "bridf, relative), or pass quantity= (--quantity)")
 
 
-def read(path: str | os.PathLike, *, angles: str | None = None, quantity: str | None = None,
-         **options: Any) -> Measurement:
-    """Read a roughbrdf CSV file (see the module docstring for the layout).
+@dataclass
+class _Header:
+    """The ``# key: value`` lines before the column names (keys lower-cased)."""
 
-    ``angles`` and ``quantity`` supply or override the header's declarations.
-    """
-    path, lines = begin_read("csv", path, options, quantity)
-    header: dict[str, str] = {}
-    hline: dict[str, int] = {}
-    col_line = None
+    keys: dict[str, str]
+    lines: dict[str, int]
+    #: index (0-based) of the column-name line
+    col_line: int
+
+    def line(self, key: str) -> int | None:
+        """1-based line of ``# key:`` (None when absent)."""
+        return self.lines.get(key)
+
+
+@dataclass
+class _Columns:
+    """The column-name line: names as written, base names (unit suffix removed, angle names
+    lower-cased) and the units given by suffixes."""
+
+    names: list[str]
+    base: list[str]
+    suffix_units: dict[str, str]
+    #: 1-based line of the column names
+    line: int
+
+
+@dataclass
+class _Roles:
+    """Which column is what: angle columns, channels, ``sigma_``, ``orig_``, ``polarization``."""
+
+    angles: dict[str, int]
+    channels: list[str]
+    channel_cols: list[int]
+    sigma_cols: dict[str, int]
+    orig_cols: dict[str, int]
+    pol_col: int | None
+
+
+# --------------------------------------------------------------------------------------------
+# phases of read()
+# --------------------------------------------------------------------------------------------
+def _read_header(lines: list[str], path: Path) -> _Header:
+    """Header phase: the ``#`` lines before the first other non-blank line (the column names):
+    ``# roughbrdf-csv N`` gives ``format_version``, ``# key: value`` a keyword; other comments
+    are ignored."""
+    keys: dict[str, str] = {}
+    key_lines: dict[str, int] = {}
     for i, raw in enumerate(lines):
         s = raw.strip()
         if not s:
             continue
-        if s.startswith("#"):
-            body = s.lstrip("#").strip()
-            if body.startswith(TAG):
-                header["format_version"] = body[len(TAG):].strip() or str(VERSION)
-                hline["format_version"] = i + 1
-                continue
-            key, sep, val = body.partition(":")
-            if sep:
-                header[key.strip().lower()] = val.strip()
-                hline[key.strip().lower()] = i + 1
+        if not s.startswith("#"):
+            return _Header(keys, key_lines, i)
+        body = s.lstrip("#").strip()
+        if body.startswith(TAG):
+            keys["format_version"] = body[len(TAG):].strip() or str(VERSION)
+            key_lines["format_version"] = i + 1
             continue
-        col_line = i
-        break
-    if col_line is None:
-        raise FormatError("no column-name line (e.g. 'theta_i,theta_r,phi,brdf')", path,
-                          len(lines) + 1)
-    names = [c.strip() for c in lines[col_line].split(",")]
-    cl = col_line + 1
+        key, sep, val = body.partition(":")
+        if sep:
+            keys[key.strip().lower()] = val.strip()
+            key_lines[key.strip().lower()] = i + 1
+    raise FormatError("no column-name line (e.g. 'theta_i,theta_r,phi,brdf')", path,
+                      len(lines) + 1)
+
+
+def _read_column_names(lines: list[str], header: _Header, path: Path) -> _Columns:
+    """Columns phase, names: comma separated, none empty, no duplicates; ``theta_i``,
+    ``theta_r`` and ``phi`` present (each may carry a ``_deg``/``_rad`` suffix, all the same)."""
+    text = lines[header.col_line]
+    names = [c.strip() for c in text.split(",")]
+    cl = header.col_line + 1
     if any(n == "" for n in names):
-        raise FormatError(f"empty column name in {lines[col_line].strip()!r}", path, cl)
+        raise FormatError(f"empty column name in {text.strip()!r}", path, cl)
     if len(set(names)) != len(names):
         dup = sorted({n for n in names if names.count(n) > 1})
         raise FormatError(f"duplicate column names {dup}", path, cl)
-
-    # --- units: option > header > column suffix ----------------------------------------------
-    suffix_units = {}
+    suffix_units: dict[str, str] = {}
     base = []
     for n in names:
         m = _SUFFIX.match(n.lower())
@@ -122,117 +176,175 @@ def read(path: str | os.PathLike, *, angles: str | None = None, quantity: str | 
                               "theta_r, phi, then one column per channel)", path, cl)
     if len(set(suffix_units.values())) > 1:
         raise FormatError(f"angle columns mix units: {names}", path, cl)
-    head_unit = header.get("angles") or header.get("angle_units") or header.get("units")
-    if angles is not None:
-        unit = "deg" if angle_factor(angles, path) != 1.0 else "rad"
-    elif head_unit:
-        unit = "deg" if angle_factor(head_unit, path, hline.get("angles")) != 1.0 else "rad"
-        if suffix_units and set(suffix_units.values()) != {unit}:
-            raise FormatError(f"'# angles: {head_unit}' contradicts the column names {names}",
-                              path, cl)
-    elif suffix_units:
-        unit = next(iter(suffix_units.values()))
-    else:
-        raise FormatError("missing angle units: add a header line '# angles: deg' or "
-                          "'# angles: rad' before the column names (or name the columns "
-                          "theta_i_deg, ...; or pass angles=)", path, cl)
-    factor = math.pi / 180.0 if unit == "deg" else 1.0
+    return _Columns(names, base, suffix_units, cl)
 
-    # --- column roles ------------------------------------------------------------------------
-    idx = {a: base.index(a) for a in _ANGLES}
-    pol_col = base.index("polarization") if "polarization" in base else None
+
+def _read_units(header: _Header, cols: _Columns, angles: str | None, path: Path) -> AngleUnit:
+    """Units phase: the ``angles=`` option, else ``# angles:`` (or ``angle_units``/``units``),
+    which the column suffixes must agree with, else the column suffixes; a file with neither
+    is refused (there is no default unit)."""
+    claims = []
+    key = next((k for k in _UNIT_KEYS if header.keys.get(k)), None)
+    if key is not None:
+        claims.append(UnitClaim((header.keys[key],), f"header {key}",
+                                f"'# angles: {header.keys[key]}'", header.line(key)))
+    if cols.suffix_units:
+        claims.append(UnitClaim(tuple(cols.suffix_units.values()), "column names",
+                                f"the column names {cols.names}", cols.line))
+    return resolve_angle_unit(angles, claims, path, default=None, agree=True,
+                              missing=_MISSING_UNITS, missing_line=cols.line)
+
+
+def _read_roles(cols: _Columns, path: Path) -> _Roles:
+    """Columns phase, roles: the angle columns, ``polarization``, ``sigma_<label>`` (one per
+    channel or none), ``orig_<name>``; every other column is a channel (at least one)."""
+    names = cols.names
+    angles = {a: cols.base.index(a) for a in _ANGLES}
+    pol_col = cols.base.index("polarization") if "polarization" in cols.base else None
     sigma_cols = {n[len("sigma_"):]: j for j, n in enumerate(names) if n.startswith("sigma_")}
     orig_cols = {n[len("orig_"):]: j for j, n in enumerate(names) if n.startswith("orig_")}
-    used = set(idx.values()) | set(sigma_cols.values()) | set(orig_cols.values())
+    used = set(angles.values()) | set(sigma_cols.values()) | set(orig_cols.values())
     if pol_col is not None:
         used.add(pol_col)
     chan_cols = [j for j in range(len(names)) if j not in used]
     channels = [names[j] for j in chan_cols]
     if not channels:
-        raise FormatError(f"no value column besides the angles: {names}", path, cl)
+        raise FormatError(f"no value column besides the angles: {names}", path, cols.line)
     if sigma_cols:
         missing = [c for c in channels if c not in sigma_cols]
         extra = [c for c in sigma_cols if c not in channels]
         if missing or extra:
             raise FormatError(f"sigma_ columns must match the channels one to one (channels "
                               f"{channels}; no sigma for {missing}; sigma without channel "
-                              f"{extra})", path, cl)
+                              f"{extra})", path, cols.line)
+    return _Roles(angles, channels, chan_cols, sigma_cols, orig_cols, pol_col)
 
-    # --- quantity ---------------------------------------------------------------------------
-    declared = header.get("quantity")
-    if declared is not None and declared not in QUANTITIES:
-        raise FormatError(f"quantity {declared!r} is not one of {QUANTITIES}", path,
-                          hline["quantity"])
-    if quantity is not None:
-        q = quantity
-    elif declared:
-        q = declared
-    elif len(channels) == 1 and channels[0].lower() in QUANTITIES:
-        q = channels[0].lower()
-    else:
-        raise FormatError("missing quantity: add a header line '# quantity: brdf' (or "
-                          "brdf_cos, bridf, relative), or pass quantity= (--quantity)", path,
-                          cl)
 
-    # --- rows -------------------------------------------------------------------------------
-    texts: list[str] = []
-    linenos: list[int] = []
-    for i in range(col_line + 1, len(lines)):
-        s = lines[i].strip()
-        if s and not s.startswith("#"):
-            texts.append(s)
-            linenos.append(i + 1)
-    if not texts:
-        raise FormatError("no data rows after the column names", path, cl)
-    polarization = None
-    ncol = len(names)
-    if pol_col is not None:
-        rows = [t.split(",") for t in texts]
-        for r, t, ln_ in zip(rows, texts, linenos, strict=True):
-            if len(r) != ncol:
-                raise FormatError(f"wrong column count: expected {ncol} values ({', '.join(names)}"
-                                  f"), found {len(r)}: {t!r}", path, ln_)
-        ptok = [r[pol_col].strip() for r in rows]
-        polarization = np.empty(len(rows))
-        cache: dict[str, float] = {}
-        for k, tok in enumerate(ptok):
-            if tok not in cache:
+def _read_quantity(header: _Header, roles: _Roles, quantity: str | None, path: Path,
+                   line: int) -> Quantity:
+    """Quantity phase: ``# quantity:`` (must be a quantity even when the option is given), the
+    ``quantity=`` option first, else the header, else the name of a single value column
+    (``brdf``...); required."""
+    claims = []
+    declared = header.keys.get("quantity")
+    if declared is not None:
+        try:
+            q = Quantity.parse(declared)
+        except ValueError:
+            raise FormatError(f"quantity {declared!r} is not one of {QUANTITIES}", path,
+                              header.line("quantity")) from None
+        claims.append(QuantityClaim(q, f"# quantity: {declared}", header.line("quantity")))
+    if len(roles.channels) == 1 and roles.channels[0].lower() in QUANTITIES:
+        claims.append(QuantityClaim(Quantity(roles.channels[0].lower()),
+                                    f"column name {roles.channels[0]!r}", line))
+    q, _ = resolve_quantity(quantity, claims, path, missing=_MISSING_QUANTITY,
+                            missing_line=line)
+    return q
+
+
+def _read_polarization(texts: list[str], linenos: list[int], cols: _Columns, pol_col: int,
+                       unit: AngleUnit, path: Path) -> tuple[list[str], np.ndarray]:
+    """Rows phase, ``polarization`` column: an angle in the file's unit, ``s``/``p``/
+    ``unpolarized``, or empty (unpolarized). Returns the rows with that field replaced by 0
+    (numeric for :func:`parse_rows`) and the angles (radians, NaN = unpolarized)."""
+    ncol = len(cols.names)
+    rows = [t.split(",") for t in texts]
+    for r, t, ln_ in zip(rows, texts, linenos, strict=True):
+        if len(r) != ncol:
+            raise FormatError(f"wrong column count: expected {ncol} values "
+                              f"({', '.join(cols.names)}), found {len(r)}: {t!r}", path, ln_)
+    polarization = np.empty(len(rows))
+    cache: dict[str, float] = {}
+    for k, r in enumerate(rows):
+        tok = r[pol_col].strip()
+        if tok not in cache:
+            try:
+                cache[tok] = float(tok) * unit.factor if tok else math.nan
+            except ValueError:
                 try:
-                    cache[tok] = float(tok) * factor if tok else math.nan
+                    cache[tok] = polarization_angle(tok)
                 except ValueError:
-                    try:
-                        cache[tok] = polarization_angle(tok)
-                    except ValueError:
-                        raise FormatError(f"polarization {tok!r} is neither an angle nor s/p/"
-                                          "unpolarized", path, linenos[k]) from None
-            polarization[k] = cache[tok]
-        texts = [",".join(r[:pol_col] + ["0"] + r[pol_col + 1:]) for r in rows]
-    data = parse_rows(texts, linenos, ncol, path, sep=",",
-                      what=f"values ({', '.join(names)})")
-    ln = np.asarray(linenos)
-    ti = check_zenith_rows(data[:, idx["theta_i"]] * factor, "theta_i", ln, path, unit=unit)
-    tr = check_zenith_rows(data[:, idx["theta_r"]] * factor, "theta_r", ln, path, unit=unit)
-    ph = azimuth_rows(data[:, idx["phi"]], "phi", ln, path) * factor
-    values = data[:, chan_cols]
-    uncertainty = data[:, [sigma_cols[c] for c in channels]] if sigma_cols else None
-    original = {k: data[:, j].copy() for k, j in orig_cols.items()}
+                    raise FormatError(f"polarization {tok!r} is neither an angle nor s/p/"
+                                      "unpolarized", path, linenos[k]) from None
+        polarization[k] = cache[tok]
+    return [",".join(r[:pol_col] + ["0"] + r[pol_col + 1:]) for r in rows], polarization
 
-    meta: dict[str, Any] = {k: v for k, v in header.items()
+
+def _read_rows(lines: list[str], header: _Header, cols: _Columns, roles: _Roles,
+               unit: AngleUnit, path: Path) -> dict[str, Any]:
+    """Rows phase: the lines after the column names (``#`` lines skipped), one number per
+    column, angles checked row by row. Returns the :class:`Measurement` arrays."""
+    texts, linenos = data_lines(lines, header.col_line + 1, comments="#")
+    if not texts:
+        raise FormatError("no data rows after the column names", path, cols.line)
+    polarization = None
+    if roles.pol_col is not None:
+        texts, polarization = _read_polarization(texts, linenos, cols, roles.pol_col, unit,
+                                                 path)
+    data = parse_rows(texts, linenos, len(cols.names), path, sep=",",
+                      what=f"values ({', '.join(cols.names)})")
+    ln = np.asarray(linenos)
+    col = {a: data[:, j] for a, j in roles.angles.items()}
+    return {
+        "theta_i": check_zenith_rows(col["theta_i"] * unit.factor, "theta_i", ln, path,
+                                     unit=unit.word),
+        "theta_r": check_zenith_rows(col["theta_r"] * unit.factor, "theta_r", ln, path,
+                                     unit=unit.word),
+        "phi": azimuth_rows(col["phi"], "phi", ln, path) * unit.factor,
+        "values": data[:, roles.channel_cols],
+        "polarization": polarization,
+        "uncertainty": (data[:, [roles.sigma_cols[c] for c in roles.channels]]
+                        if roles.sigma_cols else None),
+        "original": {k: data[:, j].copy() for k, j in roles.orig_cols.items()},
+    }
+
+
+def _meta(header: _Header, path: Path, unit: AngleUnit, has_original: bool) -> dict[str, Any]:
+    """Provenance: every header keyword but ``angles``, ``quantity`` and the format tag (as
+    strings), with ``sample``, ``instrument``, ``date`` always present."""
+    keys = header.keys
+    meta: dict[str, Any] = {k: v for k, v in keys.items()
                             if k not in ("angles", "quantity", "format_version")}
     meta.update({
         "file": str(path),
         "format": "csv",
-        "sample": header.get("sample"),
-        "instrument": header.get("instrument"),
-        "date": header.get("date"),
-        "angle_units": unit,
-        "format_version": header.get("format_version"),
+        "sample": keys.get("sample"),
+        "instrument": keys.get("instrument"),
+        "date": keys.get("date"),
+        "angle_units": unit.word,
+        "format_version": keys.get("format_version"),
     })
-    if original:
-        meta["original_units"] = header.get("original_units", "as in the source file")
-    return Measurement(theta_i=ti, theta_r=tr, phi=ph, values=values, channels=channels,
-                       quantity=q, polarization=polarization, uncertainty=uncertainty,
-                       original=original, meta=meta)
+    if has_original:
+        meta["original_units"] = keys.get("original_units", "as in the source file")
+    return meta
+
+
+def read(path: str | os.PathLike, *, angles: str | None = None, quantity: str | None = None,
+         **options: Any) -> Measurement:
+    """Read a roughbrdf CSV file (see the module docstring for the layout).
+
+    Parameters
+    ----------
+    path : str or path-like
+    angles : {"deg", "rad"}, optional
+        The angle unit, supplying or overriding ``# angles:``.
+    quantity : str, optional
+        What the values hold, supplying or overriding ``# quantity:``.
+
+    Raises
+    ------
+    FormatError
+        For anything the file gets wrong, naming the file and line.
+    """
+    path, lines = begin_read("csv", path, options, quantity)
+    header = _read_header(lines, path)
+    cols = _read_column_names(lines, header, path)
+    unit = _read_units(header, cols, angles, path)
+    roles = _read_roles(cols, path)
+    q = _read_quantity(header, roles, quantity, path, cols.line)
+    arrays = _read_rows(lines, header, cols, roles, unit, path)
+    meta = _meta(header, path, unit, bool(arrays["original"]))
+    return Measurement(channels=roles.channels, quantity=q, meta=meta, **arrays)
 
 
 def _clean(text: Any) -> str:
@@ -241,8 +353,18 @@ def _clean(text: Any) -> str:
 
 def write(measurement: Measurement, path: str | os.PathLike, *, angles: str = "deg",
           original: bool = True) -> None:
-    """Write a roughbrdf CSV file (``angles="deg"`` or ``"rad"``; ``original`` adds the source
-    file's angle columns as ``orig_<name>``)."""
+    """Write a roughbrdf CSV file (layout in the module docstring).
+
+    Parameters
+    ----------
+    measurement : Measurement
+        Any quantity; ``# quantity:`` gets its plain name (``brdf``...).
+    path : str or path-like
+    angles : {"deg", "rad"}
+        Unit of the angle and polarization columns, declared in ``# angles:``.
+    original : bool
+        Add the source file's one-dimensional numeric angle columns as ``orig_<name>``.
+    """
     m = measurement
     unit = "deg" if angle_factor(angles) != 1.0 else "rad"
     factor = 180.0 / math.pi if unit == "deg" else 1.0
@@ -267,7 +389,8 @@ def write(measurement: Measurement, path: str | os.PathLike, *, angles: str = "d
                 orig_keys.append(k)
                 names.append(f"orig_{k}")
                 cols.append(a.astype(float))
-    head = [f"# {TAG} {VERSION}", f"# angles: {unit}", f"# quantity: {m.quantity}"]
+    head = [f"# {TAG} {VERSION}", f"# angles: {unit}",
+            f"# quantity: {Quantity.parse(m.quantity).value}"]
     meta = m.meta
     for key in ("sample", "instrument", "date", "relative_to"):
         if meta.get(key):

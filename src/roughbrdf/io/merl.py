@@ -43,6 +43,7 @@ import numpy as np
 
 from ..geometry import from_rusinkiewicz, to_rusinkiewicz
 from ..measurement import Measurement
+from ..quantity import Quantity
 from ._common import FormatError
 
 __all__ = ["read", "write", "write_table", "read_table", "table_from_model", "cell_angles",
@@ -232,7 +233,7 @@ def read(path: str | os.PathLike, *, stride: int | tuple[int, int, int] = 1,
                 "phi_d": np.array(pd[keep]), "merl_index": np.array(flat[keep])}
     return Measurement(theta_i=np.clip(ti[keep], 0.0, HALF_PI),
                        theta_r=np.clip(tr[keep], 0.0, HALF_PI), phi=np.array(ph[keep]),
-                       values=vals, channels=list(CHANNELS), quantity="brdf",
+                       values=vals, channels=list(CHANNELS), quantity=Quantity.BRDF,
                        original=original, meta=meta)
 
 
@@ -247,7 +248,7 @@ def write(measurement: Measurement, path: str | os.PathLike, *,
     BRDF (``brdf``, or ``brdf_cos``/``bridf``, converted).
     """
     m = measurement
-    if m.quantity == "relative":
+    if not Quantity.parse(m.quantity).absolute:
         raise ValueError("MERL files hold absolute BRDF; a 'relative' measurement cannot be "
                          "written as MERL")
     if m.n_channels not in (1, 3):

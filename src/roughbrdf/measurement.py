@@ -9,6 +9,7 @@ explicit option and :meth:`Measurement.drop`, which returns what it removed.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -186,7 +187,7 @@ class Measurement:
         return "\n".join(lines)
 
     def bad_mask(self, *, nonfinite: bool = True, negative: bool = False,
-                 channels: list[int | str] | None = None) -> np.ndarray:
+                 channels: Sequence[int | str] | None = None) -> np.ndarray:
         """Boolean (N,) mask of the samples :meth:`drop` would remove with the same options."""
         idx = (range(self.n_channels) if channels is None
                else [self.channel_index(c) for c in channels])

@@ -186,12 +186,13 @@ def _read_units(header: _Header, angles: str | None, path: Path
     for nm in _split_vars(header.keys["VARS"]):
         m = _UNIT_IN_NAME.match(nm)
         unit = m.group("unit").strip().lower().rstrip("s") if m else ""
-        if unit not in ("deg", "degree", "rad", "radian"):
+        if m is None or unit not in ("deg", "degree", "rad", "radian"):
             names.append(nm)
             continue
-        names.append(m.group("name").strip())
-        if names[-1].lower() in _ANGLE_NAMES:
-            name_units.append(_unit_word(unit))
+        names.append(str(m.group("name")).strip())
+        word = _unit_word(unit)
+        if names[-1].lower() in _ANGLE_NAMES and word is not None:  # always a unit word here
+            name_units.append(word)
     claims = [c for c in (_header_unit_claim(header),) if c is not None]
     if name_units:
         claims.append(UnitClaim(tuple(name_units), "VARS names", "VARS", header.line("VARS")))

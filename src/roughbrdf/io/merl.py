@@ -257,7 +257,8 @@ def write(measurement: Measurement, path: str | os.PathLike, *,
     vals = m.to_brdf()
     if vals.shape[1] == 1:
         vals = np.repeat(vals, 3, axis=1)
-    dims = tuple(int(d) for d in dims)
+    d0, d1, d2 = (int(d) for d in dims)
+    dims = (d0, d1, d2)
     n = int(np.prod(dims))
     if "merl_index" in m.original and tuple(m.meta.get("merl_dims", ())) == dims:
         flat = np.asarray(m.original["merl_index"], dtype=np.int64)

@@ -24,8 +24,9 @@ Needs ``../shared/data`` (or ``ROUGHBRDF_SHARED_DATA``); prints a note and retur
    retro peak heights, measured vs the model as the instrument would read it (averaged over the
    aperture), per incidence. With ``--scan`` the fit cost is also tabulated against the aperture
    (on the test subset of ``tests/test_fitting_real.py``), which is how ``APERTURE_DEG`` was
-   chosen. With ``--docs`` the fit plots are saved as ``docs/img/rb08_<file>.png``, with the
-   aperture-averaged model drawn over the plain curves.
+   chosen. With ``--docs`` the fit plots are saved as ``docs/img/rb08_<file>.png``: the
+   panels of ``FitResult.plot`` (drawn through the fit's aperture) and a zoom on the retro peak
+   with the model at each direction and through the aperture.
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ from scipy.stats import qmc
 
 import roughbrdf as rb
 from roughbrdf import geometry
-from roughbrdf.fitting import _SingleThreadBLAS
+from roughbrdf.fitting.threads import single_thread_blas
 
 HERE = Path(__file__).resolve().parent
 DATA = Path(os.environ.get("ROUGHBRDF_SHARED_DATA", HERE.parent.parent / "shared" / "data"))
@@ -139,7 +140,7 @@ def speed() -> None:
 
     t_np, fits = best_time(lambda: by_hand(pts), repeat=1)
     t_np1, fits1 = best_time(lambda: by_hand(X0[None, :]), repeat=1)
-    with _SingleThreadBLAS():  # the same, without OpenBLAS threads (as rb.fit runs)
+    with single_thread_blas():  # the same, with one BLAS thread (as rb.fit runs)
         t_np1b, _ = best_time(lambda: by_hand(X0[None, :]), repeat=1)
     print(f"### Speed: TR75 fit of {SPEED_FILE}.astm ({meas.n_samples} geometries x "
           f"{len(meas.channels)} channels, relative loss)\n")
@@ -329,10 +330,10 @@ def rb08_cea(docs: bool = False, scan: bool = False) -> None:
 
 
 def save_rb08_plot(name: str, res) -> None:
-    """Left and middle: FitResult.plot's panels (in-plane slices and residual map, drawn with the
-    fitted model at each direction, as roughbrdf.plot does); right: a zoom on the retro peak,
-    in-plane, with the model at each direction (thin) and read through the aperture (thick,
-    what the fit compared with the data)."""
+    """Left and middle: FitResult.plot's panels (in-plane slices and residual map, the model
+    read through the fit's aperture, as the fit compared it with the data); right: a zoom on
+    the retro peak, in-plane, with the model at each direction (thin) and read through the
+    aperture (thick)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -345,8 +346,8 @@ def save_rb08_plot(name: str, res) -> None:
     ax1 = fig.add_subplot(1, 3, 1)
     ax2 = fig.add_subplot(1, 3, 2)
     ax3 = fig.add_subplot(1, 3, 3)
-    rbplot.plot_comparison(model, meas, channel=0, ax=ax1)
-    rbplot.plot_residual_map(model, meas, channel=0, ax=ax2)
+    rbplot.plot_comparison(model, meas, channel=0, ax=ax1, aperture=res.instrument)
+    rbplot.plot_residual_map(model, meas, channel=0, ax=ax2, aperture=res.instrument)
     inplane = meas.in_plane()
     incs = inplane.incidences(4)
     off = np.radians(np.linspace(-6.0, 6.0, 1201))  # 0.01 deg: resolves the retro cusp

@@ -10,11 +10,12 @@ import pytest
 
 import roughbrdf as rb
 from roughbrdf import geometry
-from roughbrdf.fitting import (
+from roughbrdf.fitting import ChannelData, Objective, ObjectiveSpec
+from roughbrdf.instrument import (
     APERTURE_POINTS,
-    _aperture_directions,
-    _Objective,
+    Aperture,
     aperture_average,
+    aperture_directions,
     aperture_stencil,
 )
 from roughbrdf.measurement import Measurement
@@ -26,7 +27,7 @@ TS67_START = {"g": 0.7, "c": 0.04, "rho_d": 0.6}
 
 
 def tr75_design() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """TR75's measurement design (MODELS.md §3.9), 5 azimuths: 6 x (5 x 5 + 1) x 2 = 312."""
+    """TR75's measurement design (docs/models.md §3.9), 5 azimuths: 6 x (5 x 5 + 1) x 2 = 312."""
     rows = []
     for gam in (90.0, 0.0):
         for b in (0, 15, 30, 45, 60, 70):
@@ -171,7 +172,8 @@ def test_free_scale_recovers_the_scale_when_the_model_scale_is_fixed():
 
 
 def test_relative_scale_is_tr75_reading_a():
-    """For the relative loss K = sum(X/f)/sum((X/f)^2) minimizes TR75's sigma (MODELS.md §3.9)."""
+    """For the relative loss K = sum(X/f)/sum((X/f)^2) minimizes TR75's sigma
+    (docs/models.md §3.9)."""
     meas = tr75_relative(seed=3)
     res = rb.fit(rb.model("trowbridge-reitz-1975", **TR75_START), meas, starts=2,
                  progress=False)
@@ -215,8 +217,10 @@ def test_jacobian_matches_central_differences():
     lo = np.array([p.bounds[0] for p in m.parameters])
     hi = np.array([p.bounds[1] for p in m.parameters])
     gam = meas.polarization
-    obj = _Objective(m, free, lo, hi, meas.theta_i, meas.theta_r, meas.phi, gam,
-                     meas.values[:, 0], None, 1, "relative", True)
+    obj = Objective(ObjectiveSpec(m, free, lo, hi, loss="relative", quantity="bridf",
+                                  free_scale=True),
+                    ChannelData.from_arrays(meas.theta_i, meas.theta_r, meas.phi,
+                                            meas.values[:, 0], polarization=gam))
     theta = np.array([0.5, 1.3, 0.7, 0.2])
     jac = obj.jac(theta)
     for j in range(theta.size):
@@ -227,8 +231,7 @@ def test_jacobian_matches_central_differences():
         col = (obj.fun(tp) - obj.fun(tm)) / (2 * h)
         assert np.allclose(jac[:, j], col, rtol=1e-4, atol=1e-6 * np.abs(col).max())
     # one compiled evaluation per column plus one for the residual: never a loop over samples
-    obj.nfev = 0
-    obj._last = None
+    obj.reset()
     obj.jac(theta)
     assert obj.nfev == theta.size + 1
 
@@ -482,7 +485,7 @@ def test_aperture_stencil_accuracy(points):
     assert wt.sum() == pytest.approx(1.0, abs=1e-14) and np.all(wt > 0)
     assert beta[0] == 0.0 and np.all(beta <= a + 1e-15)
     for tr, ph in ((0.0, 0.0), (0.4, 1.0), (0.8, -2.5)):  # the cone stays above the horizon
-        tr_s, ph_s, w = _aperture_directions(np.array([tr]), np.array([ph]), a, points)
+        tr_s, ph_s, w = aperture_directions(np.array([tr]), np.array([ph]), a, points)
         _, dirs = geometry.unit_vectors(np.zeros_like(tr_s), tr_s, ph_s)
         _, axis = geometry.unit_vectors(0.0, tr, ph)
         assert np.degrees(np.arccos(np.clip(dirs @ axis, -1, 1))).max() <= 40.0 + 1e-9
@@ -503,7 +506,7 @@ def test_aperture_stencil_accuracy(points):
 
 def test_aperture_horizon_guard_and_pole():
     """Near grazing the part of the cone below the surface is clipped to theta_r = 90 deg."""
-    tr_s, ph_s, _ = _aperture_directions(np.radians([89.5, 0.0]), np.array([0.3, 0.0]),
+    tr_s, ph_s, _ = aperture_directions(np.radians([89.5, 0.0]), np.array([0.3, 0.0]),
                                          math.radians(2.0), 19)
     assert tr_s.max() == 0.5 * math.pi and np.sum(tr_s[0] == 0.5 * math.pi) >= 6
     assert np.all(tr_s[1] <= math.radians(2.0) + 1e-12) and tr_s[1, 0] == 0.0
@@ -573,9 +576,10 @@ def test_aperture_jacobian_is_one_vectorized_evaluation_per_parameter():
     free = ["microfacet_alpha", "microfacet_ks", "lambertian_rho"]
     lo, hi = np.array([0.001, 0.0, 0.0]), np.array([1.0, 10.0, 1.0])
     x = aperture_average(m, ti, tr, ph, math.radians(1.0))
-    tr_s, ph_s, wt = _aperture_directions(tr, ph, math.radians(1.0), 19)
-    obj = _Objective(m, free, lo, hi, ti[:, None], tr_s, ph_s, np.asarray(np.nan), x, None, 0,
-                     "relative", False, 1.0, wt)
+    obj = Objective(ObjectiveSpec(m, free, lo, hi, loss="relative", quantity="brdf",
+                                  free_scale=False, fixed_scale=1.0),
+                    ChannelData.from_arrays(ti, tr, ph, x,
+                                            aperture=Aperture(math.radians(1.0), 19)))
     theta = np.array([0.03, 0.7, 0.06])
     assert np.allclose(obj.values(np.array([0.02, 0.8, 0.05])), x, rtol=1e-13)
     jac = obj.jac(theta)
@@ -586,8 +590,7 @@ def test_aperture_jacobian_is_one_vectorized_evaluation_per_parameter():
         tm[j] -= h
         col = (obj.fun(tp) - obj.fun(tm)) / (2 * h)
         assert np.allclose(jac[:, j], col, rtol=1e-4, atol=1e-6 * np.abs(col).max())
-    obj.nfev = 0
-    obj._last = None
+    obj.reset()
     obj.jac(theta)
     assert obj.nfev == theta.size + 1
 

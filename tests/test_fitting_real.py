@@ -153,7 +153,7 @@ def test_rb08_reproduces_gray_tape_retro_peak_heights_with_the_aperture(shared_d
 
 @pytest.mark.parametrize("name", ["retro-gray-tape.dat", "retro-3M-jaune.dat"])
 def test_rb08_amplitude_reading_reproduces_retro_peaks_on_all_samples(shared_data, name):
-    """The recipe that holds on ALL samples of both CEA files (MODELS.md §4.11: parameters
+    """The recipe that holds on ALL samples of both CEA files (docs/models.md §4.11: parameters
     13-14 are speculative). With the default "width" reading the retro peak can only grow with
     incidence (peak(15)/peak(60) <= 0.52 over 20,000 random parameter sets) while the gray tape's
     falls 64x (72.5, 42.5, 1.13); ``retro_shadowing="amplitude"`` lets the pair V(sin ti) V(sin ts)

@@ -193,3 +193,38 @@ def test_best_scale():
 def test_model_values_rejects_unknown_quantity(tr):
     with pytest.raises(ValueError, match="quantity"):
         plot.model_values(tr, 0.1, 0.2, 0.0, "radiance")
+
+
+def test_best_scale_is_the_inverse_of_the_relative_scale():
+    """plot uses the fit's convention (K x ~ f, roughbrdf.quantity.relative_scale); best_scale is
+    the model-side factor 1/K."""
+    from roughbrdf.quantity import relative_scale
+
+    rng = np.random.default_rng(3)
+    f = rng.uniform(0.5, 2.0, 20)
+    d = 4.0 * f * (1 + 0.1 * rng.standard_normal(20))
+    assert plot.best_scale(d, f) == pytest.approx(1.0 / relative_scale(d, f), rel=1e-14)
+
+
+def test_comparison_through_an_aperture(tr):
+    """With aperture= the curves and the residuals are the model averaged over the cone."""
+    from roughbrdf.instrument import Aperture, aperture_average
+
+    sharp = rb.model("trowbridge-reitz-1975", e=0.05, n=1.5, k=0.0, rho_L=0.01)
+    ap = Aperture(math.radians(2.0), 7)
+    meas = _in_plane_measurement(sharp, "bridf")
+    fig, ax = plot.plot_comparison(sharp, meas, aperture=ap)
+    assert "aperture 2°" in ax.get_title()
+    line = [ln for ln in ax.get_lines() if ln.get_linestyle() != "None"][1]  # 30 deg
+    x = np.radians(line.get_xdata())
+    tr_, ph = rb.geometry.from_signed_angle(x)
+    t = round(math.radians(30.0), 4)  # the plot's incidences are rounded (Measurement.incidences)
+    want = aperture_average(sharp, t, tr_, ph, ap, quantity="bridf")
+    np.testing.assert_allclose(line.get_ydata(), want, rtol=1e-8)  # x went through degrees
+    plain = plot.model_values(sharp, t, tr_, ph, "bridf")
+    assert np.max(want) < 0.9 * np.max(plain)  # the peak is read lower through the cone
+    _, res = plot.relative_residuals(sharp, meas, aperture=ap)
+    at = aperture_average(sharp, meas.theta_i, meas.theta_r, meas.phi, ap, quantity="bridf")
+    np.testing.assert_allclose(res, meas.values[:, 0] / at - 1, rtol=1e-9, atol=1e-12)
+    fig, ax = plot.plot_residual_map(sharp, meas, aperture=math.radians(2.0))
+    assert "r.m.s." in ax.get_title()

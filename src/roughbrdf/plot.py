@@ -10,6 +10,14 @@ The in-plane axis is the papers' *signed* reflection angle: ``+theta_r`` on the 
 (specular) side ``phi = 0``, ``-theta_r`` on the source side ``phi = pi``
 (:func:`roughbrdf.geometry.signed_angle`).
 
+Relative data are compared with a model through the closed-form scale ``K`` of
+:func:`roughbrdf.quantity.relative_scale` (``K x ~ f``, TR75 Eq. 34, the convention of the fit,
+``docs/fitting.md``): the data are drawn as measured and the model divided by ``K``. With
+``aperture=`` (:mod:`roughbrdf.instrument`; :meth:`FitResult.plot
+<roughbrdf.fitting.FitResult.plot>` passes the fit's own) the model is drawn, and the residuals
+taken, averaged over the instrument's aperture cone, as the fit compared it with the data.
+Matplotlib is imported when a figure is drawn, not with this module.
+
 =========================  ==================================================================
 function                   what it draws
 =========================  ==================================================================
@@ -25,23 +33,27 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from matplotlib import colors as mcolors
-from matplotlib.axes import Axes
-from matplotlib.figure import Figure
-from matplotlib.ticker import MaxNLocator
 from numpy.typing import ArrayLike
 
 from . import geometry
-from .measurement import Measurement
-from .models.base import Model
+from .instrument import Aperture, aperture_average
+from .quantity import relative_scale
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from .measurement import Measurement
+    from .models.base import Model
 
 __all__ = [
     "new_axes",
     "incidence_colors",
     "model_values",
+    "compared_values",
     "best_scale",
     "plot_in_plane",
     "plot_polar",
@@ -67,6 +79,8 @@ def new_axes(ax: Axes | None = None, *, polar: bool = False,
     """Return ``(fig, ax)``: ``ax``'s figure, or a new pyplot-free figure with one axes."""
     if ax is not None:
         return ax.get_figure(), ax
+    from matplotlib.figure import Figure
+
     fig = Figure(figsize=figsize, layout="constrained")
     ax = fig.add_subplot(projection="polar" if polar else None)
     return fig, ax
@@ -111,20 +125,32 @@ def model_values(model: Model, theta_i: ArrayLike, theta_r: ArrayLike, phi: Arra
 
 
 def best_scale(data: ArrayLike, model: ArrayLike) -> float:
-    """Closed-form scale ``K`` minimizing ``sum(((data - K model)/(K model))^2)``.
+    """The model-side factor ``1/K`` that puts a model onto data of unknown scale.
 
-    With ``r = data/model`` the objective is ``sum((r/K - 1)^2)``, minimized by
-    ``K = sum(r^2)/sum(r)`` (TR75 Eq. 34 with the scale put on the model). Only finite, positive
-    pairs are used; returns 1.0 if there are none.
+    A thin wrapper of :func:`roughbrdf.quantity.relative_scale`, which gives the data-side
+    ``K`` (``K data ~ model``, TR75 Eq. 34, as the fit uses it): ``best_scale`` is ``1/K``, the
+    factor with ``data ~ best_scale * model``. It minimizes
+    ``sum(((data - s model)/(s model))^2)`` over ``s`` (the same TR75 sigma). Only finite pairs
+    with a positive model value are used; returns 1.0 if there are none.
+
+    Examples
+    --------
+    >>> best_scale([2.0, 4.0], [1.0, 2.0])
+    2.0
     """
-    d = np.asarray(data, dtype=float)
-    m = np.asarray(model, dtype=float)
-    ok = np.isfinite(d) & np.isfinite(m) & (m > 0)
-    if not ok.any():
-        return 1.0
-    r = d[ok] / m[ok]
-    s = r.sum()
-    return float((r * r).sum() / s) if s > 0 else 1.0
+    return 1.0 / relative_scale(data, model)
+
+
+def compared_values(model: Model, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
+                    quantity: str = "brdf", polarization: Any = None,
+                    aperture: Aperture | float | None = None) -> np.ndarray:
+    """:func:`model_values`, or with ``aperture`` the model averaged over the instrument's
+    cone (:func:`roughbrdf.instrument.aperture_average`; ``brdf`` or ``bridf`` only)."""
+    if aperture is None:
+        return model_values(model, theta_i, theta_r, phi, quantity, polarization)
+    q = "bridf" if quantity in ("bridf", "brdf_cos") else quantity
+    return np.asarray(aperture_average(model, theta_i, theta_r, phi, aperture, quantity=q,
+                                       polarization=polarization), dtype=float)
 
 
 def _deg(x: ArrayLike) -> np.ndarray:
@@ -222,6 +248,8 @@ def plot_polar(model: Model, theta_i: float, elevation: float, *, n: int = 361,
     polarizations : sequence
         Polarizations to draw (default ⊥ and ∥); ``None`` adds the unpolarized mean.
     """
+    from matplotlib.ticker import MaxNLocator
+
     fig, ax = new_axes(ax, polar=True)
     psi = np.linspace(0.0, 2 * math.pi, n)
     curves = polar_curves(model, theta_i, elevation, psi, polarizations)
@@ -266,6 +294,8 @@ def plot_hemisphere(model: Model, theta_i: float, *, quantity: str = "brdf", log
     sits at ``(-sin θ_i, 0)`` and the specular direction at ``(+sin θ_i, 0)``. With ``log`` the
     colours are logarithmic; a colorbar is added.
     """
+    from matplotlib import colors as mcolors
+
     fig, ax = new_axes(ax, figsize=(5.6, 4.8))
     X, Y, tr, ph = hemisphere_grid(n)
     inside = np.isfinite(tr)
@@ -273,7 +303,6 @@ def plot_hemisphere(model: Model, theta_i: float, *, quantity: str = "brdf", log
     Z[inside] = model_values(model, theta_i, tr[inside], ph[inside], quantity, polarization)
     Z[~np.isfinite(Z)] = np.nan
     pos = Z[np.isfinite(Z) & (Z > 0)]
-    norm: mcolors.Normalize
     if log and pos.size:
         lo = vmin if vmin is not None else max(pos.min(), pos.max() * 1e-4)
         norm = mcolors.LogNorm(vmin=lo, vmax=vmax if vmax is not None else pos.max())
@@ -314,24 +343,25 @@ def _relative_to_cos(meas: Measurement) -> bool:
         "bridf", "brdf_cos")
 
 
-def _comparison_setup(model: Model, measurement: Measurement, channel: int | str
+def _comparison_setup(model: Model, measurement: Measurement, channel: int | str,
+                      aperture: Aperture | float | None = None
                       ) -> tuple[Measurement, np.ndarray, np.ndarray, str, float]:
     """Single channel; model values at the samples, matched to the data's quantity.
 
-    Returns ``(meas, data, model_at_samples, quantity_used, scale)``: ``brdf`` is compared with
+    Returns ``(meas, data, model_at_samples, quantity_used, k)``: ``brdf`` is compared with
     the model BRDF, ``brdf_cos``/``bridf`` with BRDF·cosθr, ``relative`` with the model BRDF
-    scaled by the closed-form best ``K`` (:func:`best_scale`).
+    (BRDF·cosθr when ``meta["relative_to"]`` says so) divided by the closed-form data scale
+    ``k`` (:func:`roughbrdf.quantity.relative_scale`, ``k data ~ model``; 1 for absolute data).
+    With ``aperture`` the model is averaged over the instrument's cone.
     """
     meas = measurement.select_channel(channel)
     data = meas.values[:, 0]
     q = meas.quantity
-    pol = meas.polarization
-    if q in ("brdf_cos", "bridf") or _relative_to_cos(meas):
-        mod = model_values(model, meas.theta_i, meas.theta_r, meas.phi, "bridf", pol)
-    else:
-        mod = model_values(model, meas.theta_i, meas.theta_r, meas.phi, "brdf", pol)
-    scale = best_scale(data, mod) if q == "relative" else 1.0
-    return meas, data, mod * scale, q, scale
+    curve_q = "bridf" if q in ("brdf_cos", "bridf") or _relative_to_cos(meas) else "brdf"
+    mod = compared_values(model, meas.theta_i, meas.theta_r, meas.phi, curve_q,
+                          meas.polarization, aperture)
+    k = relative_scale(data, mod) if q == "relative" else 1.0
+    return meas, data, mod / k, q, k
 
 
 def _pol_groups(meas: Measurement) -> list[tuple[Any, np.ndarray, str]]:
@@ -357,49 +387,41 @@ def _pol_mask(meas: Measurement, pol: float | None) -> np.ndarray:
     return np.isnan(g) if pol is None else g == pol
 
 
-def plot_comparison(model: Model, measurement: Measurement, *, channel: int | str = 0,
-                    ax: Axes | None = None) -> tuple[Figure, Axes]:
-    """Measurement vs model: in-plane slices on the signed angle axis, one colour per incidence.
+def _parity(ax: Axes, data: np.ndarray, mod: np.ndarray, ylabel: str, title: str) -> None:
+    """Model against data on log axes (a measurement with no in-plane samples)."""
+    ok = np.isfinite(data) & np.isfinite(mod) & (data > 0) & (mod > 0)
+    ax.loglog(data[ok], mod[ok], ".", ms=3, alpha=0.6, label="samples")
+    if ok.any():
+        lo, hi = min(data[ok].min(), mod[ok].min()), max(data[ok].max(), mod[ok].max())
+        ax.plot([lo, hi], [lo, hi], "k-", lw=0.8, label="model = data")
+    ax.set_xlabel("measured " + ylabel)
+    ax.set_ylabel("model " + ylabel)
+    ax.set_title(title + " (no in-plane samples: parity plot)", fontsize="medium")
+    ax.legend(fontsize="small")
 
-    Markers are the measured in-plane samples (``phi`` within 0.5° of 0 or 180°), lines the model
-    at the same incidence (and polarization, if the data have one). The compared quantity follows
-    ``measurement.quantity``: ``brdf`` against the model BRDF; ``brdf_cos``/``bridf`` against
-    BRDF·cosθr; ``relative`` against the model BRDF (BRDF·cosθr when ``meta["relative_to"]`` is
-    ``bridf``) times the closed-form best scale ``K``
-    (:func:`best_scale`, given in the title). The value axis is logarithmic when the data span
-    more than a factor 30. A measurement with no in-plane samples is shown as a parity plot
-    (model against data) instead.
-    """
-    fig, ax = new_axes(ax)
-    meas, data, mod, q, scale = _comparison_setup(model, measurement, channel)
-    ylabel = QUANTITY_LABELS["bridf" if q in ("bridf", "brdf_cos") else "brdf"]
-    if q == "relative":
-        ylabel = r"relative value (model BRDF $\times K$)"
-    inplane = meas.in_plane()
+
+def _comparison_title(model: Model, meas: Measurement, k: float,
+                      aperture: Aperture | float | None) -> str:
     title = f"{model.name} vs {meas.meta.get('sample') or meas.meta.get('file') or 'data'}"
     title += f" [{meas.channels[0]}]"
-    if q == "relative":
-        title += f", K = {scale:.4g}"
-    if inplane.n_samples == 0:
-        ok = np.isfinite(data) & np.isfinite(mod) & (data > 0) & (mod > 0)
-        ax.loglog(data[ok], mod[ok], ".", ms=3, alpha=0.6, label="samples")
-        if ok.any():
-            lo, hi = min(data[ok].min(), mod[ok].min()), max(data[ok].max(), mod[ok].max())
-            ax.plot([lo, hi], [lo, hi], "k-", lw=0.8, label="model = data")
-        ax.set_xlabel("measured " + ylabel)
-        ax.set_ylabel("model " + ylabel)
-        ax.set_title(title + " (no in-plane samples: parity plot)", fontsize="medium")
-        ax.legend(fontsize="small")
-        return fig, ax
+    if meas.quantity == "relative":
+        title += f", 1/K = {1 / k:.4g}"  # the model is drawn divided by K
+    a = aperture.half_angle if isinstance(aperture, Aperture) else aperture
+    if a:
+        title += f", aperture {math.degrees(a):.3g}°"
+    return title
+
+
+def _in_plane_slices(ax: Axes, model: Model, inplane: Measurement, k: float, curve_q: str,
+                     aperture: Aperture | float | None) -> np.ndarray:
+    """Data markers and model curves per incidence (and polarization); returns the data."""
     incs = inplane.incidences(4)
-    cols = incidence_colors(len(incs))
     ts_grid = _signed_grid(361, 89.5)
     tr_g, ph_g = geometry.from_signed_angle(ts_grid)
-    curve_q = "bridf" if q in ("bridf", "brdf_cos") or _relative_to_cos(meas) else "brdf"
     groups = _pol_groups(inplane)
     markers = ["o", "s", "^", "D"]
     all_vals = []
-    for t, col in zip(incs, cols, strict=True):
+    for t, col in zip(incs, incidence_colors(len(incs)), strict=True):
         sel = inplane.at_incidence(float(t), atol=1e-4)
         for gi, (pol, _mask, pname) in enumerate(groups):
             sub = sel.subset(_pol_mask(sel, pol)) if len(groups) > 1 else sel
@@ -410,11 +432,56 @@ def plot_comparison(model: Model, measurement: Measurement, *, channel: int | st
             all_vals.append(y)
             ax.plot(x, y, ls="none", marker=markers[gi % 4], ms=3.5, mfc="none", color=col,
                     label=rf"data $\theta_i$ = {math.degrees(t):.3g}°{pname}")
-            yc = scale * model_values(model, float(t), tr_g, ph_g, curve_q, pol)
+            yc = compared_values(model, float(t), tr_g, ph_g, curve_q, pol, aperture) / k
             ax.plot(_deg(ts_grid), yc, color=col, lw=1.2, ls="-" if gi == 0 else "--",
                     label=rf"model $\theta_i$ = {math.degrees(t):.3g}°{pname}")
-    vals = np.concatenate(all_vals) if all_vals else np.array([])
-    # the data set the value range (a model can diverge at grazing, e.g. unshadowed TR75)
+    return np.concatenate(all_vals) if all_vals else np.array([])
+
+
+def plot_comparison(model: Model, measurement: Measurement, *, channel: int | str = 0,
+                    ax: Axes | None = None, aperture: Aperture | float | None = None
+                    ) -> tuple[Figure, Axes]:
+    """Measurement vs model: in-plane slices on the signed angle axis, one colour per incidence.
+
+    Markers are the measured in-plane samples (``phi`` within 0.5° of 0 or 180°), lines the model
+    at the same incidence (and polarization, if the data have one). The compared quantity follows
+    ``measurement.quantity``: ``brdf`` against the model BRDF; ``brdf_cos``/``bridf`` against
+    BRDF·cosθr; ``relative`` against the model BRDF (BRDF·cosθr when ``meta["relative_to"]`` is
+    ``bridf``) divided by the closed-form data scale ``K``
+    (:func:`roughbrdf.quantity.relative_scale`, ``K x ~ f`` as in the fit; ``1/K`` is given in
+    the title). With ``aperture``
+    (radians, or an :class:`~roughbrdf.instrument.Aperture`) the model is averaged over the
+    instrument's cone (:func:`roughbrdf.instrument.aperture_average`), as a fit with that
+    aperture compared it with the data. The value axis is logarithmic when the data span
+    more than a factor 30. A measurement with no in-plane samples is shown as a parity plot
+    (model against data) instead.
+    """
+    fig, ax = new_axes(ax)
+    meas, data, mod, q, k = _comparison_setup(model, measurement, channel, aperture)
+    ylabel = QUANTITY_LABELS["bridf" if q in ("bridf", "brdf_cos") else "brdf"]
+    if q == "relative":
+        ylabel = rf"relative value (model {'BRIDF' if _relative_to_cos(meas) else 'BRDF'} / $K$)"
+    inplane = meas.in_plane()
+    title = _comparison_title(model, meas, k, aperture)
+    if inplane.n_samples == 0:
+        _parity(ax, data, mod, ylabel, title)
+        return fig, ax
+    curve_q = "bridf" if q in ("bridf", "brdf_cos") or _relative_to_cos(meas) else "brdf"
+    _value_axis(ax, _in_plane_slices(ax, model, inplane, k, curve_q, aperture))
+    ax.set_xlim(-90, 90)
+    ax.set_xticks(np.arange(-90, 91, 30))
+    ax.set_xlabel(SIGNED_LABEL)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize="medium")
+    ax.grid(True, alpha=0.3)
+    n_curves = len(inplane.incidences(4)) * len(_pol_groups(inplane))
+    ax.legend(fontsize="x-small", ncol=2 if n_curves > 4 else 1)
+    return fig, ax
+
+
+def _value_axis(ax: Axes, vals: np.ndarray) -> None:
+    """The data set the value range (a model can diverge at grazing, e.g. unshadowed TR75);
+    logarithmic when they span more than a factor 30."""
     if _auto_log(vals):
         ax.set_yscale("log")
         pos = vals[np.isfinite(vals) & (vals > 0)]
@@ -424,38 +491,35 @@ def plot_comparison(model: Model, measurement: Measurement, *, channel: int | st
         fin = vals[np.isfinite(vals)]
         lo, hi = min(0.0, float(fin.min())), float(fin.max())
         ax.set_ylim(lo - 0.05 * (hi - lo), hi + 0.25 * (hi - lo) if hi > lo else hi + 1.0)
-    ax.set_xlim(-90, 90)
-    ax.set_xticks(np.arange(-90, 91, 30))
-    ax.set_xlabel(SIGNED_LABEL)
-    ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize="medium")
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize="x-small", ncol=2 if len(incs) * len(groups) > 4 else 1)
-    return fig, ax
 
 
-def relative_residuals(model: Model, measurement: Measurement, *, channel: int | str = 0
+def relative_residuals(model: Model, measurement: Measurement, *, channel: int | str = 0,
+                       aperture: Aperture | float | None = None
                        ) -> tuple[Measurement, np.ndarray]:
-    """``(meas, (data - model)/model)`` for one channel, with the quantity handling of
-    :func:`plot_comparison` (NaN where the model is not positive and finite)."""
-    meas, data, mod, _q, _s = _comparison_setup(model, measurement, channel)
+    """``(meas, (data - model)/model)`` for one channel, with the quantity and aperture
+    handling of :func:`plot_comparison` (NaN where the model is not positive and finite); for
+    relative data ``(K x - f)/f``, TR75's residual (Eq. 34)."""
+    meas, data, mod, _q, _k = _comparison_setup(model, measurement, channel, aperture)
     with np.errstate(divide="ignore", invalid="ignore"):
         res = np.where(np.isfinite(mod) & (mod > 0), (data - mod) / mod, np.nan)
     return meas, res
 
 
 def plot_residual_map(model: Model, measurement: Measurement, *, channel: int | str = 0,
-                      ax: Axes | None = None) -> tuple[Figure, Axes]:
+                      ax: Axes | None = None, aperture: Aperture | float | None = None
+                      ) -> tuple[Figure, Axes]:
     """Relative residual ``(data - model)/model`` of every sample on the projected disk.
 
     Each sample sits at ``(sin θr cos φ, sin θr sin φ)`` (forward side to the right), coloured
     by its residual on a diverging scale symmetric about 0 (clipped at the 98th percentile of
     ``|residual|``, and at ±1 at most: a factor 2 off is saturated); each incidence has its own
-    marker. The r.m.s. relative residual (TR75's
-    σ, Eq. 34) is in the title.
+    marker. The r.m.s. relative residual (TR75's σ, Eq. 34) is in the title. ``aperture``: as
+    for :func:`plot_comparison`.
     """
+    from matplotlib import colors as mcolors
+
     fig, ax = new_axes(ax, figsize=(6.0, 4.8))
-    meas, res = relative_residuals(model, measurement, channel=channel)
+    meas, res = relative_residuals(model, measurement, channel=channel, aperture=aperture)
     x = np.sin(meas.theta_r) * np.cos(meas.phi)
     y = np.sin(meas.theta_r) * np.sin(meas.phi)
     ok = np.isfinite(res)

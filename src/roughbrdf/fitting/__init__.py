@@ -1,0 +1,187 @@
+"""Fitting models to measurements: :func:`fit` and :class:`FitResult` (``docs/fitting.md``).
+
+Data flows one way: file -> :func:`roughbrdf.read` -> :class:`~roughbrdf.measurement.Measurement`
+-> :func:`fit` -> :class:`FitResult` -> report, JSON, plots. Models know nothing about fitting: the
+fitter reads ``model.parameters`` (value, bounds) and rebuilds the model with
+``model.with_values``. Each channel is fitted on its own; ``scipy.optimize.least_squares``
+(trust-region reflective, box bounds) minimizes the sum of squared residuals, one per sample:
+``(K x - f)/f`` by default, whose r.m.s. is TR75's sigma (Eq. 34).
+
+One job per module:
+
+=========================================  ===================================================
+:mod:`~roughbrdf.fitting.setup`            the options, checked before any work; the free
+                                           parameters and bounds; the data scale ``K``
+:mod:`~roughbrdf.fitting.data`             one channel's samples: the compared quantity, what
+                                           is left out (and counted), the weights
+:mod:`~roughbrdf.fitting.objective`        the residuals (losses, closed-form ``K``) and the
+                                           compiled finite-difference Jacobians
+:mod:`~roughbrdf.fitting.search`           Sobol screening, multistart exploration, polish
+:mod:`~roughbrdf.fitting.statistics`       covariance, stderr, correlations, chi2, AIC/BIC,
+                                           sigma, rms-log
+:mod:`~roughbrdf.fitting.result`           :class:`ChannelFit`, :class:`FitResult`, JSON,
+                                           plots, saving
+:mod:`~roughbrdf.fitting.report`           the text report
+:mod:`~roughbrdf.fitting.threads`          one BLAS thread during a fit (threadpoolctl)
+:mod:`roughbrdf.instrument`                the instrument aperture (cone average)
+=========================================  ===================================================
+
+Importing this package loads neither SciPy nor Matplotlib: they are imported when a fit runs
+or a plot is drawn.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
+from ..instrument import APERTURE_POINTS, Aperture, aperture_average, aperture_stencil
+from ..quantity import LOSSES
+from .data import ChannelData, Comparison, DataOptions, prepare_channel
+from .objective import Objective, ObjectiveSpec
+from .result import ChannelFit, FitResult
+from .search import MultiStart, SearchOptions, progress_bar
+from .setup import (
+    FreeParameters,
+    as_model,
+    channel_indices,
+    check_enough_data,
+    data_scale,
+    model_label,
+)
+from .threads import single_thread_blas
+
+if TYPE_CHECKING:
+    from ..measurement import Measurement
+    from ..models import Model
+
+__all__ = ["fit", "FitResult", "ChannelFit", "LOSSES", "APERTURE_POINTS", "aperture_stencil",
+           "aperture_average", "ChannelData", "Objective", "ObjectiveSpec"]
+
+
+def fit(model: Model | str, measurement: Measurement, *,
+        channel: int | str | Sequence | None = None, loss: str = "relative",
+        weights: Any = None, fix: Iterable[str] = (),
+        bounds: Mapping[str, Sequence[float]] | None = None, starts: int = 8,
+        seed: int | None = 0, nonfinite: str = "raise", negative: str = "keep",
+        relative_to: str | None = None, free_scale: bool | None = None,
+        scale: float | None = None,
+        screen: int = 64, subsample: int | None = 1000, polish: int = 2,
+        max_nfev: int | None = None, aperture: float | None = None,
+        aperture_points: int = 19,
+        progress: bool | None = None) -> FitResult:
+    """Fit ``model`` to ``measurement``, each channel on its own.
+
+    Parameters
+    ----------
+    model : Model or str
+        Model with starting values (``rb.model(...)``; sums allowed), or a registered name.
+    measurement : Measurement
+        The data (:func:`roughbrdf.read`).
+    channel : int, str, list or None
+        Channel(s) to fit (labels or positions); ``None`` fits every channel.
+    loss : {"relative", "log", "absolute"}
+        Residual: ``(x - f)/f`` (TR75 Eq. 34), ``ln x - ln f`` or ``x - f``
+        (:mod:`~roughbrdf.fitting.objective`).
+    weights : None, array or "uncertainty"
+        Multiplies each residual; shape (N,) or (N, C). ``"uncertainty"`` uses the measurement's
+        uncertainty ``u``: ``1/u`` for the absolute loss, ``x/u`` for the relative and log losses.
+        Samples of weight 0 are left out (and counted).
+    fix : iterable of str
+        Parameters kept at the model's value. Parameters whose value is ``None`` (parts switched
+        off, e.g. TS67 ``n=None``) are never fitted.
+    bounds : dict, optional
+        ``name -> (low, high)``, overriding the model's default search ranges.
+    starts : int
+        Local fits per channel: one from the model's values, then ``starts - 1`` from Sobol
+        points in the bounds (``starts=1`` is a plain local fit from the model's values).
+    screen : int
+        Number of Sobol points in the bounds whose cost is evaluated (one model evaluation
+        each) to choose the ``starts - 1`` starting points: the lowest-cost ones, kept at least
+        0.15 of the bounds apart.
+    seed : int or None
+        Seed of the scrambled Sobol sequence and of the subsample (results are reproducible).
+    nonfinite : {"raise", "drop"}
+        What to do with NaN/inf measured values.
+    negative : {"keep", "drop", "clip"}
+        What to do with negative measured values (non-positive ones for ``loss="log"``, where
+        ``keep`` raises). ``clip`` sets them to 0 (to the smallest positive value for the log
+        loss). Counts are reported in ``excluded``.
+    relative_to : {"brdf", "bridf"}, optional
+        For ``relative`` data: the model quantity the values are proportional to. Default
+        ``measurement.meta["relative_to"]`` if the reader found it, else ``"brdf"``.
+    free_scale : bool, optional
+        Fit a free scale ``K`` of the data in closed form. Default: only for ``relative`` data.
+        A model with an overall scale parameter of its own (TS67 ``rho_d``, microfacet ``ks``
+        alone) cannot tell it from ``K``: fix that parameter when fitting relative data.
+    scale : float, optional
+        A known data scale ``K`` (``x -> K x``) instead of a fitted one, e.g. for relative data
+        whose absolute calibration is known; the fit is then the absolute fit.
+    subsample : int or None
+        Above this many samples, the starts are explored on a fixed random subsample and the
+        ``polish`` best end points refined on all samples. ``None`` uses all samples throughout.
+    polish : int
+        Number of explored end points refined on the full data.
+    max_nfev : int, optional
+        Limit of function evaluations per local fit (``least_squares``).
+    aperture : float or None
+        Instrument angular response: half-angle (radians) of a uniform cone about the measured
+        reflection direction. Each sample is compared with the model averaged over that cone
+        (:mod:`roughbrdf.instrument`); ``None`` or 0: the model at the sample's direction. Must
+        satisfy ``0 <= aperture < pi/2``.
+    aperture_points : {7, 19, 37}
+        Size of the cubature rule over the cone (:func:`~roughbrdf.instrument.aperture_stencil`);
+        the fit costs about that many times more model evaluations.
+    progress : bool or None
+        Show a tqdm progress bar; ``None`` shows it only on an interactive terminal.
+
+    Returns
+    -------
+    FitResult
+
+    Raises
+    ------
+    ValueError
+        Unknown loss or option, every parameter fixed, no data left in a channel, non-finite
+        values with ``nonfinite="raise"``, non-positive values for the log loss with
+        ``negative="keep"``, an aperture that is negative, not finite or >= pi/2.
+    """
+    t_start = time.perf_counter()
+    model = as_model(model)
+    chans = channel_indices(measurement, channel)
+    ap = Aperture.parse(aperture, aperture_points)
+    opts = DataOptions(Comparison.of(measurement, relative_to), loss, weights, nonfinite,
+                       negative, ap)
+    search = SearchOptions(starts, screen, subsample, polish, max_nfev, seed)
+    k_free, k_fixed = data_scale(measurement, free_scale, scale)
+    params = FreeParameters.of(model, fix, bounds)
+    spec = params.spec(model, loss=loss, quantity=opts.comparison.quantity, free_scale=k_free,
+                       fixed_scale=k_fixed)
+    # every channel first, so that bad input fails before any work
+    data = [prepare_channel(model, measurement, j, opts) for j in chans]
+    check_enough_data(measurement, data, spec.n_varys)
+    results: list[ChannelFit] = []
+    with progress_bar(progress, len(chans) * search.starts,
+                      f"fit {model_label(model)}") as bar, single_thread_blas():
+        runner = MultiStart(spec, search, None if bar is None else lambda: bar.update(1))
+        for d in data:
+            t0 = time.perf_counter()
+            if bar is not None:
+                bar.set_postfix_str(d.label)
+            obj, outcome = runner.run(d)
+            results.append(ChannelFit.from_search(obj, outcome, time.perf_counter() - t0))
+    options = {"starts": search.starts, "seed": seed, "subsample": subsample,
+               "polish": search.polish, "nonfinite": nonfinite, "negative": negative,
+               "free_scale": k_free, "scale": scale,
+               "aperture": None if ap is None else ap.half_angle,
+               "aperture_points": None if ap is None else ap.points,
+               "fix": sorted(set(model.param_names) - set(params.names)),
+               "weights": None if weights is None else
+               (weights if isinstance(weights, str) else "array")}
+    return FitResult(channels=results, measurement=measurement, model_name=model_label(model),
+                     loss=loss, compared=opts.comparison.compared,
+                     relative_to=opts.comparison.relative_to, options=options,
+                     elapsed=time.perf_counter() - t_start,
+                     aperture=None if ap is None else ap.half_angle,
+                     aperture_points=int(aperture_points))

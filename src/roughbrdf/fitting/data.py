@@ -1,0 +1,327 @@
+"""The data of a fit, one channel at a time: what is compared, what is left out, the weights.
+
+``docs/fitting.md`` ("What is minimized") describes the rules implemented here:
+
+* :class:`Comparison` -- the model quantity the data are compared with: the BRDF for ``brdf``
+  data, BRDF cos(theta_r) (TR75's BRIDF) for ``brdf_cos``/``bridf`` data, and for ``relative``
+  data what they are proportional to (``relative_to``);
+* :func:`prepare_channel` -- the samples of one channel that enter the fit, as a
+  :class:`ChannelData`. Samples are never dropped silently: non-finite values raise or are
+  dropped (``nonfinite``), negative ones are kept, dropped or clipped (``negative``), samples of
+  weight 0, where the model is not finite or not defined, and (BRDF cos data with the relative or
+  log loss) at ``theta_r = 90`` deg are left out, and every count is kept in
+  :attr:`ChannelData.excluded` (:data:`EXCLUSION_REASONS`);
+* :func:`channel_weights` -- the residual weights (an array, or ``"uncertainty"``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..instrument import Aperture, InstrumentGeometry
+from ..quantity import LOSSES, Quantity
+
+if TYPE_CHECKING:
+    from ..measurement import Measurement
+    from ..models import Model
+
+__all__ = ["Comparison", "ChannelData", "DataOptions", "EXCLUSION_REASONS", "channel_weights",
+           "excluded_text", "prepare_channel", "where"]
+
+#: the reasons a sample is left out or changed, in the order reports list them
+EXCLUSION_REASONS: dict[str, str] = {
+    "nonfinite": "non-finite",
+    "negative": "negative (dropped)",
+    "clipped": "negative (clipped)",
+    "zero_weight": "of zero weight",
+    "model_domain": "where the model is not finite or not defined",
+    "horizon": "at theta_r = 90 deg (BRDF cos theta_r = 0 for every model)",
+}
+
+
+def excluded_text(excluded: dict[str, int]) -> str:
+    """The counts of :attr:`ChannelData.excluded` in words (``"none"`` when nothing).
+
+    Examples
+    --------
+    >>> excluded_text({"nonfinite": 2, "negative": 0})
+    '2 non-finite'
+    >>> excluded_text({})
+    'none'
+    """
+    return ", ".join(f"{v} {EXCLUSION_REASONS.get(k, k)}" for k, v in excluded.items() if v) \
+        or "none"
+
+
+def where(meas: Measurement, label: str) -> str:
+    """``"file, channel 'label'"`` for error messages."""
+    f = meas.meta.get("file")
+    return f"{f}, channel {label!r}" if f else f"channel {label!r}"
+
+
+# --------------------------------------------------------------------------------------------
+# what is compared
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Comparison:
+    """The model quantity a measurement is compared with.
+
+    Attributes
+    ----------
+    quantity : Quantity
+        ``Quantity.BRDF`` or ``Quantity.BRIDF`` (BRDF cos theta_r).
+    relative_to : str or None
+        For relative data, what they are proportional to (``"brdf"`` or ``"bridf"``); None for
+        absolute data.
+
+    Examples
+    --------
+    >>> from roughbrdf.measurement import Measurement
+    >>> m = Measurement([0.1], [0.2], [0.0], [1.0], quantity="relative",
+    ...                 meta={"relative_to": "brdf_cos"})
+    >>> Comparison.of(m)
+    Comparison(quantity=<Quantity.BRIDF: 'bridf'>, relative_to='bridf')
+    """
+
+    quantity: Quantity
+    relative_to: str | None = None
+
+    @classmethod
+    def of(cls, meas: Measurement, relative_to: str | None = None) -> Comparison:
+        """For ``meas``; ``relative_to`` overrides ``meas.meta["relative_to"]`` (default
+        ``"brdf"``) for relative data."""
+        q = Quantity.parse(meas.quantity)
+        if q is Quantity.BRDF:
+            return cls(Quantity.BRDF)
+        if q.cosine_weighted:
+            return cls(Quantity.BRIDF)
+        rel = relative_to or meas.meta.get("relative_to") or "brdf"
+        rel = {"brdf_cos": "bridf"}.get(str(rel).lower(), str(rel).lower())
+        if rel not in ("brdf", "bridf"):
+            raise ValueError(f"relative_to must be 'brdf' or 'bridf' (what the relative values "
+                             f"are proportional to), got {rel!r}")
+        return cls(Quantity(rel), rel)
+
+    @property
+    def compared(self) -> str:
+        """``"brdf"`` or ``"bridf"``."""
+        return self.quantity.value
+
+
+@dataclass(frozen=True)
+class DataOptions:
+    """How :func:`prepare_channel` treats the samples (the options of :func:`roughbrdf.fit`)."""
+
+    comparison: Comparison
+    loss: str = "relative"
+    weights: Any = None
+    nonfinite: str = "raise"
+    negative: str = "keep"
+    aperture: Aperture | None = None
+
+    def __post_init__(self) -> None:
+        if self.loss not in LOSSES:
+            raise ValueError(f"unknown loss {self.loss!r}; choose one of {', '.join(LOSSES)}")
+        if self.nonfinite not in ("raise", "drop"):
+            raise ValueError(f"nonfinite must be 'raise' or 'drop', got {self.nonfinite!r}")
+        if self.negative not in ("keep", "drop", "clip"):
+            raise ValueError(f"negative must be 'keep', 'drop' or 'clip', got "
+                             f"{self.negative!r}")
+
+
+# --------------------------------------------------------------------------------------------
+# one channel's samples
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ChannelData:
+    """The samples of one channel that enter a fit.
+
+    Attributes
+    ----------
+    values : numpy.ndarray, shape (N,)
+        The measured values ``x`` (after ``negative="clip"``), in the measurement's own scale.
+    geometry : InstrumentGeometry
+        Where the model is evaluated for each sample (through the aperture, if any).
+    weights : numpy.ndarray or None
+        Residual weights, shape (N,).
+    label : str
+        Channel label.
+    index : numpy.ndarray
+        Indices of the samples in the measurement.
+    excluded : dict
+        Samples left out or changed, by reason (:data:`EXCLUSION_REASONS`).
+    """
+
+    values: np.ndarray
+    geometry: InstrumentGeometry
+    weights: np.ndarray | None = None
+    label: str = ""
+    index: np.ndarray = field(default=None, repr=False)  # type: ignore[arg-type]
+    excluded: dict[str, int] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.index is None:
+            object.__setattr__(self, "index", np.arange(self.values.size))
+
+    @classmethod
+    def from_arrays(cls, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
+                    values: ArrayLike, *, polarization: ArrayLike | None = None,
+                    weights: ArrayLike | None = None, aperture: Aperture | None = None,
+                    label: str = "") -> ChannelData:
+        """Samples given as 1-d arrays inside the hemisphere (nothing is left out).
+
+        Examples
+        --------
+        >>> d = ChannelData.from_arrays([0.1, 0.2], [0.3, 0.4], [0.0, 3.0], [1.0, 2.0])
+        >>> d.n, d.geometry.stencil_size
+        (2, 1)
+        """
+        x = np.ascontiguousarray(values, dtype=float)
+        gam = (np.asarray(np.nan) if polarization is None
+               else np.broadcast_to(np.asarray(polarization, dtype=float), x.shape).copy())
+        geo = InstrumentGeometry.build(np.asarray(theta_i, dtype=float),
+                                       np.asarray(theta_r, dtype=float),
+                                       np.asarray(phi, dtype=float), gam, aperture)
+        w = None if weights is None else np.ascontiguousarray(weights, dtype=float)
+        return cls(x, geo, w, label)
+
+    @property
+    def n(self) -> int:
+        """Number of samples."""
+        return int(self.values.size)
+
+    def take(self, sub: np.ndarray) -> ChannelData:
+        """The samples at positions ``sub`` (e.g. the exploration subsample)."""
+        return replace(self, values=self.values[sub], geometry=self.geometry.take(sub),
+                       weights=None if self.weights is None else self.weights[sub],
+                       index=self.index[sub])
+
+
+def channel_weights(weights: Any, meas: Measurement, j: int, x: np.ndarray, loss: str
+                    ) -> np.ndarray | None:
+    """Weights of channel ``j`` (None: unweighted).
+
+    ``weights`` is None, an array of shape (N,) or (N, C), or ``"uncertainty"``: the
+    measurement's uncertainty ``u`` gives ``1/u`` for the absolute loss and ``x/u`` (the inverse
+    relative uncertainty) for the relative and log losses, 0 where ``u`` is not positive.
+    """
+    if weights is None:
+        return None
+    if isinstance(weights, str):
+        if weights != "uncertainty":
+            raise ValueError(f"weights must be None, an array or 'uncertainty', got {weights!r}")
+        if meas.uncertainty is None:
+            raise ValueError("weights='uncertainty' but the measurement has no uncertainty")
+        u = meas.uncertainty[:, j]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            w = 1.0 / u if loss == "absolute" else np.abs(x) / u
+        return np.where(np.isfinite(w) & (u > 0), w, 0.0)
+    w = np.asarray(weights, dtype=float)
+    if w.ndim == 2:
+        if w.shape != meas.values.shape:
+            raise ValueError(f"weights of shape {w.shape} do not match the values "
+                             f"{meas.values.shape}")
+        w = w[:, j]
+    w = np.broadcast_to(w, (meas.n_samples,)).astype(float)
+    if not np.all(np.isfinite(w)) or np.any(w < 0):
+        raise ValueError("weights must be finite and >= 0")
+    return w
+
+
+def _bad_values(x: np.ndarray, keep: np.ndarray, excluded: dict[str, int],
+                opts: DataOptions, place: str) -> None:
+    """Non-finite and negative values (non-positive for the log loss): raise, drop or clip.
+
+    Updates ``x`` (clipping), ``keep`` and ``excluded`` in place."""
+    bad = ~np.isfinite(x)
+    if bad.any():
+        if opts.nonfinite == "raise":
+            rows = np.flatnonzero(bad)
+            show = ", ".join(str(r) for r in rows[:8]) + (" ..." if rows.size > 8 else "")
+            raise ValueError(f"{place}: {rows.size} non-finite value(s) at sample(s) {show}; "
+                             f"pass nonfinite='drop' to fit without them")
+        keep &= ~bad
+        excluded["nonfinite"] = int(bad.sum())
+    log = opts.loss == "log"
+    neg = np.isfinite(x) & ((x <= 0) if log else (x < 0))
+    if not neg.any():
+        return
+    if opts.negative == "keep":
+        if log:
+            raise ValueError(f"{place}: the log loss needs positive values but "
+                             f"{int(neg.sum())} are <= 0; pass negative='drop' or "
+                             f"negative='clip'")
+    elif opts.negative == "drop":
+        keep &= ~neg
+        excluded["negative"] = int(neg.sum())
+    else:  # clip
+        pos = x[np.isfinite(x) & (x > 0)]
+        x[neg] = (pos.min() if pos.size else 1.0) if log else 0.0
+        excluded["clipped"] = int(neg.sum())
+
+
+def _outside_domain(model: Model, meas: Measurement, keep: np.ndarray,
+                    excluded: dict[str, int], opts: DataOptions) -> None:
+    """Leave out (in ``keep``) the samples the model cannot be compared with."""
+    if not model.grazing_incidence:
+        graze = keep & (meas.theta_i >= 0.5 * math.pi)
+        excluded["model_domain"] += int(graze.sum())
+        keep &= ~graze
+    if opts.comparison.quantity.cosine_weighted and opts.loss != "absolute":
+        # BRDF cos(theta_r) of every model is 0 at theta_r = 90 deg: a measured value there (a
+        # noise floor) has no relative or logarithmic residual
+        horizon = keep & (np.cos(meas.theta_r) <= 1e-12)
+        excluded["horizon"] = int(horizon.sum())
+        keep &= ~horizon
+    # samples where the model itself is not finite at the starting values (e.g. the BRDF of the
+    # unshadowed TR75 model at theta_r = 90 deg, which is +inf): these cannot be fitted. With
+    # an aperture, the model averaged over the cone (as the fit compares it) is checked.
+    idx = np.flatnonzero(keep)
+    if idx.size:
+        f0 = _instrument_geometry(meas, idx, opts.aperture).evaluate(
+            model, opts.comparison.quantity)
+        ok = np.isfinite(f0)
+        if not ok.all():
+            excluded["model_domain"] += int((~ok).sum())
+            keep[idx[~ok]] = False
+
+
+def _instrument_geometry(meas: Measurement, idx: np.ndarray, aperture: Aperture | None
+                         ) -> InstrumentGeometry:
+    gam = (np.asarray(np.nan) if meas.polarization is None
+           else np.ascontiguousarray(meas.polarization[idx]))
+    return InstrumentGeometry.build(meas.theta_i[idx], meas.theta_r[idx], meas.phi[idx], gam,
+                                    aperture)
+
+
+def prepare_channel(model: Model, meas: Measurement, j: int, opts: DataOptions) -> ChannelData:
+    """The samples of channel ``j`` that enter the fit of ``model``; every one left out counted.
+
+    Raises ``ValueError`` (naming the file and channel) for non-finite values with
+    ``nonfinite="raise"``, non-positive values for the log loss with ``negative="keep"``, and
+    a channel with no sample left.
+    """
+    label = meas.channels[j]
+    place = where(meas, label)
+    x = meas.values[:, j].astype(float).copy()
+    keep = np.ones(x.size, dtype=bool)
+    excluded = dict.fromkeys(EXCLUSION_REASONS, 0)
+    _bad_values(x, keep, excluded, opts, place)
+    w = channel_weights(opts.weights, meas, j, x, opts.loss)
+    if w is not None:
+        excluded["zero_weight"] = int((keep & (w == 0)).sum())
+        keep &= w > 0
+    _outside_domain(model, meas, keep, excluded, opts)
+    idx = np.flatnonzero(keep)
+    if idx.size == 0:
+        total = int(x.size)
+        raise ValueError(f"{place}: no data to fit ({total} samples; left out: "
+                         + excluded_text(excluded) + ")"
+                         if total else f"{place}: no data to fit (0 samples)")
+    return ChannelData(x[idx], _instrument_geometry(meas, idx, opts.aperture),
+                       None if w is None else w[idx], label, idx, excluded)

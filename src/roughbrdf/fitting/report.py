@@ -1,0 +1,122 @@
+"""The lmfit-style text report of a fit (``report.txt``, ``roughbrdf fit`` on the terminal).
+
+One header block for the fit (model, data quantity, what it is compared with, loss, aperture),
+then per channel: success and message, points (and what was left out, with the reasons of
+:data:`roughbrdf.fitting.data.EXCLUSION_REASONS`), variables, starts, model evaluations, chi2,
+reduced chi2, AIC, BIC, TR75's sigma (Eq. 34) and the r.m.s. log residual, the parameters with
+their standard errors, initial values and bounds, the scale ``K``, and the correlations above
+``min_correl``. ``docs/fitting.md`` shows an example.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+from .data import excluded_text
+
+if TYPE_CHECKING:
+    from .result import ChannelFit, FitResult
+
+__all__ = ["report", "fmt"]
+
+_LOSS_TEXT = {"relative": "relative, (x - f)/f  (TR75 Eq. 34)",
+              "log": "log, ln x - ln f", "absolute": "absolute, x - f"}
+
+
+def fmt(v: float | None, digits: int = 6) -> str:
+    """``v`` with ``digits`` significant digits (``"None"``, ``"nan"`` and ``"inf"`` as such).
+
+    Examples
+    --------
+    >>> fmt(0.123456789), fmt(None), fmt(float("nan")), fmt(2.0, 3)
+    ('0.123457', 'None', 'nan', '2')
+    """
+    if v is None:
+        return "None"
+    if not math.isfinite(v):
+        return str(v)
+    return f"{v:.{digits}g}"
+
+
+def report(result: FitResult, *, min_correl: float = 0.1) -> str:
+    """The text report of ``result`` (:meth:`FitResult.report
+    <roughbrdf.fitting.FitResult.report>`)."""
+    lines = _header(result)
+    for c in result.channels:
+        lines += ["", *_channel(c), *_variables(c), *_correlations(c, min_correl)]
+    return "\n".join(lines)
+
+
+def _header(result: FitResult) -> list[str]:
+    meta = result.measurement.meta
+    src = meta.get("file") or meta.get("sample") or "<measurement in memory>"
+    comp = f"model {result.compared}"
+    if result.relative_to:
+        comp += " (relative data: free scale K, x -> K x, closed form)"
+    ap = result.instrument
+    return [f"[[Fit]] {result.model_name} to {src}",
+            f"    data quantity      = {result.measurement.quantity}",
+            f"    compared with      = {comp}",
+            f"    loss               = {_LOSS_TEXT[result.loss]}",
+            "    aperture           = " + (
+                "none (model at each measured direction)" if ap is None else ap.describe()),
+            f"    channels           = {len(result.channels)}",
+            f"    time               = {result.elapsed:.3g} s"]
+
+
+def _channel(c: ChannelFit) -> list[str]:
+    nst = len([s for s in c.starts if s["stage"] != "full"])
+    return [
+        f"[[Channel {c.channel}]]",
+        f"    success            = {c.success}  ({c.message})",
+        f"    # data points      = {c.n_points}  (left out / changed: "
+        f"{excluded_text(c.excluded)})",
+        f"    # variables        = {c.n_varys}"
+        + ("  (including the scale K)" if c.free_scale else ""),
+        f"    # starts           = {nst}",
+        f"    # model evals      = {c.nfev}",
+        f"    chi-square         = {fmt(c.chi2)}",
+        f"    reduced chi-square = {fmt(c.redchi)}",
+        f"    Akaike info crit   = {fmt(c.aic)}",
+        f"    Bayesian info crit = {fmt(c.bic)}",
+        f"    TR75 sigma         = {fmt(c.sigma, 4)}   (r.m.s. of (Kx - f)/f)",
+        f"    r.m.s. log resid.  = {fmt(c.rms_log, 4)}",
+    ]
+
+
+def _variable(c: ChannelFit, name: str, val: float | None) -> str:
+    if name not in c.free:
+        return "None (switched off)" if val is None else f"{fmt(val, 7)} (fixed)"
+    se = c.stderr.get(name)
+    pct = (f" ({100 * se / abs(val):.2f}%)"
+           if se is not None and math.isfinite(se) and val else "")
+    lo, hi = c.bounds[name]
+    return (f"{fmt(val, 7)} +/- {fmt(se, 4)}{pct} (init = {fmt(c.init[name])}, "
+            f"bounds [{fmt(lo)}, {fmt(hi)}])")
+
+
+def _variables(c: ChannelFit) -> list[str]:
+    width = max(len(n) for n in [*c.params, "scale K"])
+    lines = ["[[Variables]]"]
+    lines += [f"    {name:<{width}}: {_variable(c, name, val)}" for name, val in c.params.items()]
+    if c.free_scale:
+        lines.append(f"    {'scale K':<{width}}: {fmt(c.scale, 7)} +/- "
+                     f"{fmt(c.scale_stderr, 4)} (closed form)")
+    elif c.scale != 1.0:
+        lines.append(f"    {'scale K':<{width}}: {fmt(c.scale, 7)} (given)")
+    return lines
+
+
+def _correlations(c: ChannelFit, min_correl: float) -> list[str]:
+    pairs = []
+    names = list(c.correl)
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            v = c.correl[a].get(b)
+            if v is not None and math.isfinite(v) and abs(v) >= min_correl:
+                pairs.append((abs(v), a, b, v))
+    if not pairs:
+        return []
+    return [f"[[Correlations]] (unreported correlations are < {min_correl:.3f})",
+            *(f"    C({a}, {b}) = {v:+.4f}" for _, a, b, v in sorted(pairs, reverse=True))]

@@ -1,0 +1,398 @@
+"""What a fit returns: :class:`ChannelFit` per channel and :class:`FitResult` for the whole fit.
+
+``FitResult`` gives the fitted model as the fit compared it with the data
+(:meth:`FitResult.predict`, through the instrument aperture if the fit had one), the ``fit.json``
+content
+(:meth:`FitResult.to_dict`, :meth:`FitResult.to_json`), the text report
+(:mod:`roughbrdf.fitting.report`), the plots (:meth:`FitResult.plot`, drawn by
+:mod:`roughbrdf.plot` through the fit's aperture) and :meth:`FitResult.save`. The keys of
+``fit.json`` are listed in ``docs/fitting.md`` ("Output files").
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..instrument import Aperture, aperture_average
+from ..quantity import Quantity
+from .statistics import Covariance, GoodnessOfFit
+
+if TYPE_CHECKING:
+    from ..measurement import Measurement
+    from ..models import Model
+    from .objective import Objective
+    from .search import SearchOutcome
+
+__all__ = ["ChannelFit", "FitResult"]
+
+
+@dataclass
+class ChannelFit:
+    """The fit of one channel (lmfit ``MinimizerResult``-like).
+
+    Attributes
+    ----------
+    channel : str
+        Channel label.
+    model : Model
+        The fitted model.
+    params : dict
+        Every parameter of the model (fitted, fixed and switched off) -> value.
+    free : list of str
+        Names of the fitted parameters.
+    init : dict
+        Starting values of the free parameters (the model's values before the fit).
+    bounds : dict
+        ``name -> (low, high)`` used for the free parameters.
+    stderr : dict
+        ``name -> standard error`` (``None`` for fixed parameters, ``nan`` if not estimable).
+    correl : dict
+        ``name -> {other: correlation}`` among the free parameters (and ``"scale"``).
+    covar : numpy.ndarray
+        Covariance of ``free`` (+ ``scale`` last if it is free).
+    scale, scale_stderr : float
+        The data scale ``K`` (``x -> K x``; 1 and 0 when the data are absolute).
+    success : bool
+    message : str
+    sigma : float
+        TR75 sigma: r.m.s. of ``(K x - f)/f`` over the fitted samples (Eq. 34).
+    rms_log : float
+        r.m.s. of ``ln(K x) - ln f`` over the fitted samples with ``x > 0``.
+    chi2, redchi, aic, bic : float
+        ``sum(r^2)`` of the loss residuals, ``chi2/(N - n_varys)``, and lmfit's
+        ``N ln(chi2/N) + 2 n_varys`` and ``N ln(chi2/N) + ln(N) n_varys``.
+    n_points, n_varys : int
+    excluded : dict
+        Samples left out or changed, by reason (``nonfinite``, ``negative``, ``clipped``,
+        ``zero_weight``, ``model_domain``: model not finite there, ``horizon``: theta_r = 90 deg
+        with BRDF cos data and the relative or log loss).
+    nfev : int
+        Model evaluations (each one vectorized over all samples of the stage).
+    starts : list of dict
+        Every start: ``{"x0": ..., "cost": ..., "stage": "explore"|"full"|"single"}``.
+    elapsed : float
+        Seconds.
+    index : numpy.ndarray
+        Indices (into the measurement) of the fitted samples.
+    data : numpy.ndarray
+        The fitted values (after ``negative="clip"``), in the measurement's own scale.
+    fitted : numpy.ndarray
+        The model at those samples (the quantity compared; averaged over the aperture when the
+        fit had one).
+    residual : numpy.ndarray
+        The loss residuals at the optimum.
+    """
+
+    channel: str
+    model: Model
+    params: dict[str, float | None]
+    free: list[str]
+    init: dict[str, float]
+    bounds: dict[str, tuple[float, float]]
+    stderr: dict[str, float | None]
+    correl: dict[str, dict[str, float]]
+    covar: np.ndarray
+    scale: float
+    scale_stderr: float
+    success: bool
+    message: str
+    sigma: float
+    rms_log: float
+    chi2: float
+    redchi: float
+    aic: float
+    bic: float
+    n_points: int
+    n_varys: int
+    excluded: dict[str, int]
+    nfev: int
+    starts: list[dict[str, Any]]
+    elapsed: float
+    free_scale: bool
+    index: np.ndarray = field(repr=False)
+    data: np.ndarray = field(repr=False)
+    fitted: np.ndarray = field(repr=False)
+    residual: np.ndarray = field(repr=False)
+
+    @property
+    def metrics(self) -> dict[str, float | int]:
+        """The figures of merit, as in ``fit.json``."""
+        return {"sigma": self.sigma, "rms_log": self.rms_log, "chi2": self.chi2,
+                "redchi": self.redchi, "aic": self.aic, "bic": self.bic,
+                "n_points": self.n_points, "n_varys": self.n_varys}
+
+    @classmethod
+    def from_search(cls, obj: Objective, outcome: SearchOutcome, elapsed: float) -> ChannelFit:
+        """The channel's result at the search's optimum: statistics on all samples of ``obj``
+        (:mod:`~roughbrdf.fitting.statistics`)."""
+        spec, data, theta = obj.spec, obj.data, outcome.theta
+        fitted_model = spec.model_at(theta)
+        f = obj.values(theta)
+        k = obj.scale(f)
+        r = obj.residual_of(f, k)
+        gof = GoodnessOfFit.of(r, data.values, f, scale=k, n_varys=spec.n_varys,
+                               floor=obj.floor)
+        cov = Covariance.at_optimum(obj, theta, f, k, chi2=gof.chi2, dof=gof.dof)
+        sd = cov.stderr()
+        stderr: dict[str, float | None] = dict.fromkeys(spec.model.param_names)
+        stderr.update({nm: float(s) for nm, s in zip(cov.names, sd, strict=True)
+                       if nm != "scale"})
+        res = outcome.result
+        message = (res.message.rstrip(".") if res is not None else "no local fit finished")
+        message += cov.note + _bound_note(theta, spec.lower, spec.upper, spec.free)
+        return cls(
+            channel=data.label, model=fitted_model, params=fitted_model.params,
+            free=list(spec.free), init=spec.start_values(),
+            bounds={nm: (float(a), float(b))
+                    for nm, a, b in zip(spec.free, spec.lower, spec.upper, strict=True)},
+            stderr=stderr, correl=cov.correl(), covar=cov.matrix, scale=float(k),
+            scale_stderr=float(sd[-1]) if spec.free_scale else 0.0,
+            success=bool(res.success) if res is not None else False, message=message,
+            sigma=gof.sigma, rms_log=gof.rms_log, chi2=gof.chi2, redchi=gof.redchi,
+            aic=gof.aic, bic=gof.bic, n_points=gof.n_points, n_varys=gof.n_varys,
+            excluded=data.excluded, nfev=obj.nfev + outcome.explore_nfev, starts=outcome.tried,
+            free_scale=spec.free_scale, elapsed=elapsed, index=data.index, data=data.values,
+            fitted=f, residual=r)
+
+    def to_dict(self) -> dict[str, Any]:
+        """This channel's entry of ``fit.json`` (before NaN -> null)."""
+        return {"channel": self.channel, "params": self.params, "stderr": self.stderr,
+                "success": bool(self.success), "metrics": self.metrics,
+                "message": self.message, "free": self.free, "init": self.init,
+                "bounds": {k: list(v) for k, v in self.bounds.items()}, "scale": self.scale,
+                "scale_stderr": self.scale_stderr, "correl": self.correl,
+                "excluded": self.excluded, "nfev": self.nfev, "elapsed_s": self.elapsed,
+                "model_spec": self.model.to_dict()}
+
+
+def _bound_note(theta: np.ndarray, lo: np.ndarray, hi: np.ndarray, names: Any) -> str:
+    """``"; at a bound: a, b"`` for the parameters within 1e-9 of the bounds' span of one."""
+    tol = 1e-9 * (hi - lo)
+    at = [nm for nm, t, a, b, e in zip(names, theta, lo, hi, tol, strict=True)
+          if abs(t - a) <= e or abs(t - b) <= e]
+    return f"; at a bound: {', '.join(at)}" if at else ""
+
+
+def clean_json(v: Any) -> Any:
+    """JSON-safe copy: NaN/inf -> None, numpy scalars and arrays -> Python.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> clean_json({"a": np.float64("nan"), "b": (np.int64(2), 0.5)})
+    {'a': None, 'b': [2, 0.5]}
+    """
+    if isinstance(v, dict):
+        return {str(k): clean_json(x) for k, x in v.items()}
+    if isinstance(v, list | tuple):
+        return [clean_json(x) for x in v]
+    if isinstance(v, np.ndarray):
+        return clean_json(v.tolist())
+    if isinstance(v, np.integer):
+        return int(v)
+    if isinstance(v, float | np.floating):
+        v = float(v)
+        return v if math.isfinite(v) else None
+    return v
+
+
+@dataclass
+class FitResult:
+    """Result of :func:`roughbrdf.fit`: one :class:`ChannelFit` per fitted channel.
+
+    ``aperture`` / ``aperture_points`` record the instrument aperture the fit used (None: none;
+    :attr:`instrument` gives it as an :class:`~roughbrdf.instrument.Aperture`); :meth:`predict`
+    evaluates the fitted model the way the fit compared it with the data. ``res[label]`` or
+    ``res[i]`` gives a channel. For a fit of a single channel, ``model``, ``params``, ``stderr``,
+    ``correl``, ``sigma``, ``rms_log`` and ``message`` are that channel's; with several channels
+    they raise and point to ``res[...]``. ``success`` is true when every channel succeeded.
+    """
+
+    channels: list[ChannelFit]
+    measurement: Measurement = field(repr=False)
+    model_name: str
+    loss: str
+    compared: str
+    relative_to: str | None
+    options: dict[str, Any]
+    elapsed: float
+    #: instrument aperture of the fit (half-angle, radians; None: none) and its stencil size; kept
+    #: so that predictions and plots average the model the same way (:meth:`predict`, :meth:`plot`)
+    aperture: float | None = None
+    aperture_points: int = 19
+
+    # single-channel shortcuts -------------------------------------------------------------------
+    def _one(self, what: str) -> ChannelFit:
+        if len(self.channels) != 1:
+            labels = ", ".join(repr(c.channel) for c in self.channels)
+            raise AttributeError(
+                f"this fit has {len(self.channels)} channels ({labels}); use "
+                f"res[channel].{what} or res.channels[i].{what}")
+        return self.channels[0]
+
+    @property
+    def model(self) -> Model:
+        return self._one("model").model
+
+    @property
+    def params(self) -> dict[str, float | None]:
+        return self._one("params").params
+
+    @property
+    def stderr(self) -> dict[str, float | None]:
+        return self._one("stderr").stderr
+
+    @property
+    def correl(self) -> dict[str, dict[str, float]]:
+        return self._one("correl").correl
+
+    @property
+    def sigma(self) -> float:
+        return self._one("sigma").sigma
+
+    @property
+    def rms_log(self) -> float:
+        return self._one("rms_log").rms_log
+
+    @property
+    def message(self) -> str:
+        return self._one("message").message
+
+    @property
+    def success(self) -> bool:
+        return all(c.success for c in self.channels)
+
+    @property
+    def instrument(self) -> Aperture | None:
+        """The fit's aperture as an :class:`~roughbrdf.instrument.Aperture` (None: none)."""
+        return None if self.aperture is None else Aperture(self.aperture, self.aperture_points)
+
+    def __getitem__(self, key: int | str) -> ChannelFit:
+        if isinstance(key, str):
+            for c in self.channels:
+                if c.channel == key:
+                    return c
+            raise KeyError(f"no channel {key!r}; fitted: {[c.channel for c in self.channels]}")
+        return self.channels[key]
+
+    def __len__(self) -> int:
+        return len(self.channels)
+
+    def __iter__(self):
+        return iter(self.channels)
+
+    def predict(self, theta_i: Any, theta_r: Any, phi: Any, *, channel: int | str = 0,
+                polarization: Any = None, aperture: bool = True) -> np.ndarray | float:
+        """The fitted model of ``channel`` as compared with the data: the quantity ``compared``
+        (BRDF or BRDF cos theta_r), averaged over the fit's aperture (``aperture=False``: at the
+        given directions only). On the model's absolute scale; relative data are ``K x``."""
+        c = self[channel]
+        q = "bridf" if self.compared in ("bridf", "brdf_cos") else "brdf"
+        return aperture_average(c.model, theta_i, theta_r, phi,
+                                self.instrument if aperture else None, quantity=q,
+                                polarization=polarization)
+
+    # output ---------------------------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """The ``fit.json`` content (keys ``model``, ``file``, ``loss``, ``channels`` ...)."""
+        meta = self.measurement.meta
+        ap = self.instrument
+        return clean_json({
+            "model": self.model_name, "file": meta.get("file"), "loss": self.loss,
+            "quantity": self.measurement.quantity, "compared": self.compared,
+            "relative_to": self.relative_to, "sample": meta.get("sample"),
+            "options": self.options, "aperture": None if ap is None else ap.to_dict(),
+            "elapsed_s": self.elapsed, "channels": [c.to_dict() for c in self.channels],
+        })
+
+    def to_json(self, path: str | None = None, *, indent: int = 2) -> str:
+        """JSON text of :meth:`to_dict` (strict JSON: NaN written as ``null``); optionally saved."""
+        text = json.dumps(self.to_dict(), indent=indent, allow_nan=False)
+        if path is not None:
+            with open(path, "w", encoding="utf-8") as fh:
+                fh.write(text + "\n")
+        return text
+
+    def report(self, *, min_correl: float = 0.1) -> str:
+        """lmfit-style text report of every channel (:func:`roughbrdf.fitting.report.report`)."""
+        from .report import report
+
+        return report(self, min_correl=min_correl)
+
+    def __str__(self) -> str:
+        return self.report()
+
+    def plot_data(self, channel: int | str = 0) -> tuple[Model, Measurement]:
+        """The fitted model and the fitted samples of one channel on the model's absolute scale.
+
+        Relative data are multiplied by the fitted ``K`` and labelled with the quantity they were
+        compared with (``brdf`` or ``bridf``), so that data and model share one axis.
+        """
+        c = self[channel]
+        meas = self.measurement.subset(c.index).select_channel(c.channel)
+        q = self.compared if self.compared in ("brdf", "bridf") else self.measurement.quantity
+        meas = replace(meas, values=(c.scale * c.data)[:, None],
+                       quantity=Quantity.BRIDF if q in ("bridf", "brdf_cos") else Quantity.BRDF,
+                       uncertainty=None, meta=dict(meas.meta))
+        return c.model, meas
+
+    def plot(self, channel: int | str = 0, *, fig: Any = None) -> tuple[Any, Any]:
+        """Data vs model (in-plane slices per incidence) and the residual map of one channel.
+
+        Uses :func:`roughbrdf.plot.plot_comparison` and :func:`roughbrdf.plot.plot_residual_map`
+        with the fit's aperture: the model is drawn (and the residuals taken) as the fit compared
+        it with the data. Returns ``(fig, (ax_comparison, ax_residuals))``; a new figure is a
+        pyplot-free :class:`matplotlib.figure.Figure`.
+        """
+        from .. import plot as rbplot
+
+        model, meas = self.plot_data(channel)
+        if fig is None:
+            from matplotlib.figure import Figure
+
+            fig = Figure(figsize=(12, 5), layout="constrained")
+        ax1 = fig.add_subplot(1, 2, 1)
+        ax2 = fig.add_subplot(1, 2, 2)
+        ap = self.instrument
+        rbplot.plot_comparison(model, meas, channel=0, ax=ax1, aperture=ap)
+        rbplot.plot_residual_map(model, meas, channel=0, ax=ax2, aperture=ap)
+        if fig.get_layout_engine() is None:  # a figure of the caller's without a layout
+            fig.tight_layout()
+        return fig, (ax1, ax2)
+
+    def plot_names(self) -> list[str]:
+        """File names :meth:`save` gives the per-channel plots (``fit_<channel>.png``)."""
+        out = []
+        for c in self.channels:
+            safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in c.channel)
+            out.append(f"fit_{safe or 'channel'}.png")
+        return out
+
+    def save(self, out_dir: str | Any, *, plots: bool = True, force: bool = False,
+             dpi: int = 110) -> list[Any]:
+        """Write ``fit.json``, ``report.txt`` and one ``fit_<channel>.png`` per channel.
+
+        ``out_dir`` may exist. Files roughbrdf wrote there before are replaced; any other file of
+        the same name stops the call with ``FileExistsError`` before anything is written, unless
+        ``force=True`` (see :mod:`roughbrdf._outdir`). Returns the paths written.
+        """
+        from .._outdir import OutputDir
+
+        out = OutputDir(out_dir, force=force)
+        names = ["fit.json", "report.txt", *(self.plot_names() if plots else [])]
+        out.check(names)
+        written = [out.file("fit.json")]
+        self.to_json(str(written[0]))
+        written.append(out.write_text("report.txt", self.report()))
+        if plots:
+            for i, name in enumerate(self.plot_names()):
+                fig, _ = self.plot(i)
+                path = out.file(name)
+                fig.savefig(path, dpi=dpi, metadata={"Software": "roughbrdf"})
+                written.append(path)
+        return written

@@ -1,0 +1,253 @@
+"""The global search of one channel: Sobol screening, local fits from several starts, polish.
+
+``docs/fitting.md`` ("Global search"): ``starts`` local fits (``scipy.optimize.least_squares``,
+trust-region reflective, box bounds) per channel: one from the model's own values, one from the
+previous channel's optimum when there is one (a warm start), and ``starts - 1`` from scrambled
+Sobol points (:func:`sobol_points`) in the bounds of the free parameters, chosen by
+:func:`screen` among ``screen`` candidates (one model evaluation each: the lowest cost, kept at
+least :data:`SCREEN_DIST` of the bounds apart). When a channel has more than ``subsample``
+samples, the local fits explore a fixed random subsample (loose tolerance
+:data:`EXPLORE_TOL`: they only need to find the basin) and the ``polish`` best distinct end
+points are refined on all samples (:data:`POLISH_TOL`); the best is the result.
+
+SciPy is imported when a search runs, not with this module.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .objective import Objective, ObjectiveSpec
+
+if TYPE_CHECKING:
+    from .data import ChannelData
+
+__all__ = ["MultiStart", "SearchOptions", "SearchOutcome", "local_fit", "progress_bar",
+           "screen", "sobol_points", "EXPLORE_TOL", "POLISH_TOL", "SCREEN_DIST"]
+
+#: tolerance (ftol, xtol, gtol) of the exploring local fits
+EXPLORE_TOL = 1e-4
+#: tolerance of the polish on all samples
+POLISH_TOL = 1e-8
+#: screened starts are kept at least this far apart (max-norm, in units of the bounds)
+SCREEN_DIST = 0.15
+#: end points of the exploration closer than this (in units of the bounds) are one point
+DISTINCT_END = 1e-3
+X_SCALE = "jac"
+
+
+@dataclass(frozen=True)
+class SearchOptions:
+    """The search settings of :func:`roughbrdf.fit` (see its parameters)."""
+
+    starts: int = 8
+    screen: int = 64
+    subsample: int | None = 1000
+    polish: int = 2
+    max_nfev: int | None = None
+    seed: int | None = 0
+
+    def __post_init__(self) -> None:
+        starts = int(self.starts)
+        if starts < 1:
+            raise ValueError(f"starts must be >= 1, got {starts}")
+        object.__setattr__(self, "starts", starts)
+        object.__setattr__(self, "polish", max(1, int(self.polish)))
+
+    @property
+    def n_screen(self) -> int:
+        """Sobol candidates evaluated to choose the ``starts - 1`` Sobol starts."""
+        return max(self.starts - 1, int(self.screen)) if self.starts > 1 else 0
+
+
+@dataclass
+class SearchOutcome:
+    """The result of one channel's search.
+
+    Attributes
+    ----------
+    theta : numpy.ndarray
+        The best point (free parameters).
+    result : scipy.optimize.OptimizeResult or None
+        Its local fit.
+    tried : list of dict
+        Every local fit: ``{"x0", "x", "cost", "stage"}`` with ``stage`` ``"single"`` (on all
+        samples, no polish), ``"explore"`` (on the subsample) or ``"full"`` (polish).
+    explore_nfev : int
+        Model evaluations of the exploration on the subsample (0 without one).
+    """
+
+    theta: np.ndarray
+    result: Any
+    tried: list[dict[str, Any]] = field(default_factory=list)
+    explore_nfev: int = 0
+
+
+def sobol_points(lower: np.ndarray, upper: np.ndarray, n: int, seed: Any) -> np.ndarray:
+    """``n`` scrambled Sobol points (:class:`scipy.stats.qmc.Sobol`) in the box, shape (n, d).
+
+    Examples
+    --------
+    >>> p = sobol_points(np.array([0.0, 1.0]), np.array([1.0, 3.0]), 5, seed=0)
+    >>> p.shape, bool(((p >= [0, 1]) & (p <= [1, 3])).all())
+    ((5, 2), True)
+    """
+    d = len(lower)
+    if n <= 0:
+        return np.empty((0, d))
+    from scipy.stats import qmc
+
+    sampler = qmc.Sobol(d, scramble=True, seed=seed)
+    m = max(0, math.ceil(math.log2(n)))
+    return lower + sampler.random_base2(m)[:n] * (upper - lower)
+
+
+def screen(obj: Objective, candidates: np.ndarray, k: int) -> list[np.ndarray]:
+    """The ``k`` best candidates by cost (one model evaluation each), skipping points closer
+    than :data:`SCREEN_DIST` (in units of the bounds) to a better one already kept; filled up
+    with the next best when too few are far apart."""
+    if k <= 0 or candidates.shape[0] == 0:
+        return []
+    if candidates.shape[0] <= k:
+        return list(candidates)
+    costs = np.array([obj.cost(c) for c in candidates])
+    order = np.argsort(costs, kind="stable")
+    lo, hi = obj.spec.lower, obj.spec.upper
+    u = (candidates - lo) / (hi - lo)
+    kept: list[int] = []
+    for i in order:
+        if all(np.max(np.abs(u[i] - u[j])) >= SCREEN_DIST for j in kept):
+            kept.append(int(i))
+        if len(kept) == k:
+            break
+    for i in order:
+        if len(kept) == k:
+            break
+        if int(i) not in kept:
+            kept.append(int(i))
+    return [candidates[i] for i in kept]
+
+
+def local_fit(obj: Objective, x0: np.ndarray, tol: float, max_nfev: int | None) -> Any:
+    """One ``least_squares`` (trf, ``x_scale="jac"``) of ``obj`` from ``x0`` with the
+    compiled finite-difference Jacobian."""
+    from scipy.optimize import least_squares
+
+    return least_squares(obj.fun, x0, jac=obj.jac, bounds=(obj.spec.lower, obj.spec.upper),
+                         method="trf", x_scale=X_SCALE, max_nfev=max_nfev,
+                         ftol=tol, xtol=tol, gtol=tol)
+
+
+def _distinct(points: list[np.ndarray], k: int, span: np.ndarray) -> list[np.ndarray]:
+    """The first ``k`` points (sorted best first) that differ by more than
+    :data:`DISTINCT_END` of the bounds from every point kept before."""
+    chosen: list[np.ndarray] = []
+    for x in points:
+        if all(np.max(np.abs(x - c) / span) > DISTINCT_END for c in chosen):
+            chosen.append(x)
+        if len(chosen) == k:
+            break
+    return chosen
+
+
+def search(full: Objective, explore: Objective, starts: list[np.ndarray],
+           options: SearchOptions, on_start: Callable[[], Any] | None = None) -> SearchOutcome:
+    """Local fits of ``explore`` from each start; when ``explore`` is a subsample, the
+    ``polish`` best distinct end points refined on ``full``. ``on_start`` is called after each
+    exploring fit (progress)."""
+    lo, hi = full.spec.lower, full.spec.upper
+    single = explore is full
+    tried: list[dict[str, Any]] = []
+    ends: list[tuple[float, np.ndarray, Any]] = []
+    for p0 in starts:
+        p0 = np.clip(p0, lo, hi)
+        res = local_fit(explore, p0, EXPLORE_TOL, options.max_nfev)
+        tried.append({"x0": p0.tolist(), "x": res.x.tolist(), "cost": float(res.cost),
+                      "stage": "single" if single else "explore"})
+        ends.append((float(res.cost), res.x, res))
+        if on_start is not None:
+            on_start()
+    ends.sort(key=lambda e: e[0])
+    if single:
+        return SearchOutcome(ends[0][1], ends[0][2], tried, 0)
+    chosen = _distinct([e[1] for e in ends], options.polish, hi - lo)
+    best_cost, best_x, best = math.inf, chosen[0], None
+    for xe in chosen:
+        res = local_fit(full, xe, POLISH_TOL, options.max_nfev)
+        tried.append({"x0": xe.tolist(), "x": res.x.tolist(), "cost": float(res.cost),
+                      "stage": "full"})
+        if res.cost < best_cost:
+            best_cost, best_x, best = float(res.cost), res.x, res
+    return SearchOutcome(best_x, best, tried, explore.nfev)
+
+
+class MultiStart:
+    """The search over the channels of one fit, in order.
+
+    Holds what the channels share: the Sobol candidates, the random generator of the
+    subsamples (both from ``options.seed``) and the previous channel's optimum (the warm start).
+
+    Examples
+    --------
+    >>> import roughbrdf as rb
+    >>> from roughbrdf.fitting import ChannelData
+    >>> spec = ObjectiveSpec(rb.model("lambertian", rho=0.9), ["rho"], [0.0], [1.0])
+    >>> data = ChannelData.from_arrays([0.1, 0.3, 0.5], [0.2, 0.4, 0.6], [0.0, 1.0, 2.0],
+    ...                                [0.1, 0.1, 0.1])
+    >>> obj, out = MultiStart(spec, SearchOptions(starts=2)).run(data)
+    >>> round(float(out.theta[0]), 6), len(out.tried)             # rho = 0.1 pi
+    (0.314159, 2)
+    """
+
+    def __init__(self, spec: ObjectiveSpec, options: SearchOptions,
+                 on_start: Callable[[], Any] | None = None) -> None:
+        self.spec = spec
+        self.options = options
+        self.on_start = on_start
+        self.rng = np.random.default_rng(options.seed)
+        self.candidates = sobol_points(spec.lower, spec.upper, options.n_screen, options.seed)
+        self.start = np.array(list(spec.start_values().values()))
+        self.warm: np.ndarray | None = None
+
+    def objectives(self, data: ChannelData) -> tuple[Objective, Objective]:
+        """``(full, explore)``: the objective on all samples, and on the subsample (the same
+        object when there is no subsample)."""
+        full = Objective(self.spec, data)
+        n_sub = self.options.subsample
+        if n_sub is None or data.n <= n_sub:
+            return full, full
+        sub = np.sort(self.rng.choice(data.n, size=int(n_sub), replace=False))
+        return full, Objective(self.spec, data.take(sub))
+
+    def run(self, data: ChannelData) -> tuple[Objective, SearchOutcome]:
+        """Search one channel; returns the objective on all its samples and the outcome."""
+        full, explore = self.objectives(data)
+        starts = [self.start] + ([self.warm] if self.warm is not None else []) + screen(
+            explore, self.candidates, self.options.starts - 1)
+        outcome = search(full, explore, starts, self.options, self.on_start)
+        self.warm = outcome.theta.copy()
+        return full, outcome
+
+
+@contextmanager
+def progress_bar(show: bool | None, total: int, desc: str) -> Iterator[Any]:
+    """A tqdm bar (``show=None``: only on an interactive terminal), or None."""
+    if show is None:
+        show = bool(getattr(sys.stderr, "isatty", lambda: False)())
+    if not show:
+        yield None
+        return
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=total, desc=desc, unit="start", leave=False)
+    try:
+        yield bar
+    finally:
+        bar.close()

@@ -1,0 +1,159 @@
+"""Figures of merit and uncertainties of a fitted channel (``docs/fitting.md``, "Uncertainties
+and statistics").
+
+* :class:`GoodnessOfFit` -- ``chi2 = sum(r^2)`` of the loss residuals (weighted), ``redchi =
+  chi2/(N - n_varys)``, lmfit's ``aic = N ln(chi2/N) + 2 n_varys`` and ``bic = N ln(chi2/N) +
+  ln(N) n_varys``, TR75's ``sigma`` (:func:`tr75_sigma`, Eq. 34) and :func:`rms_log`;
+* :class:`Covariance` -- ``covar = (J^T J)^-1 chi2/(N - n_varys)``, ``J`` the central-difference
+  Jacobian of the residuals at the optimum (free parameters, plus the analytic column of the
+  scale ``K`` when it is free): scaled by the residual variance as lmfit does by default
+  (``scale_covar=True``); ``stderr = sqrt(diag(covar))``, ``correl`` is ``covar`` normalized. A
+  singular ``J^T J`` gives NaN and a note for the message.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from .objective import Objective
+
+__all__ = ["Covariance", "GoodnessOfFit", "rms_log", "tr75_sigma"]
+
+
+def tr75_sigma(data: np.ndarray, model: np.ndarray, scale: float = 1.0,
+               floor: float = 0.0) -> float:
+    """TR75's sigma (Eq. 34): the r.m.s. of ``(K x - f)/f`` (``f`` floored at ``floor``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> round(tr75_sigma(np.array([1.0, 2.0]), np.array([1.1, 1.8])), 6)
+    0.101514
+    """
+    rel = (scale * data - model) / np.maximum(model, floor)
+    return float(np.sqrt(np.mean(rel * rel))) if rel.size else math.nan
+
+
+def rms_log(data: np.ndarray, model: np.ndarray, scale: float = 1.0) -> float:
+    """r.m.s. of ``ln(K x) - ln f`` over the samples where both are positive (NaN if none).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> round(rms_log(np.array([1.0, -1.0]), np.array([np.e, 1.0])), 12)
+    1.0
+    """
+    pos = (data > 0) & (model > 0)
+    if not pos.any():
+        return math.nan
+    return float(np.sqrt(np.mean((np.log(scale * data[pos]) - np.log(model[pos])) ** 2)))
+
+
+@dataclass(frozen=True)
+class GoodnessOfFit:
+    """Figures of merit of a fitted channel (the ``metrics`` of ``fit.json``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> g = GoodnessOfFit.of(np.array([0.1, -0.1, 0.2]), np.array([1.0, 2.0, 3.0]),
+    ...                      np.array([1.0, 2.0, 3.0]), scale=1.0, n_varys=1)
+    >>> round(g.chi2, 12), round(g.redchi, 12), g.sigma
+    (0.06, 0.03, 0.0)
+    """
+
+    chi2: float
+    redchi: float
+    aic: float
+    bic: float
+    sigma: float
+    rms_log: float
+    n_points: int
+    n_varys: int
+
+    @classmethod
+    def of(cls, residual: np.ndarray, data: np.ndarray, model: np.ndarray, *, scale: float,
+           n_varys: int, floor: float = 0.0) -> GoodnessOfFit:
+        """From the loss residuals, the data ``x``, the model values ``f`` and the scale ``K``."""
+        n = residual.size
+        chi2 = float(residual @ residual)
+        dof = n - n_varys
+        lchi = math.log(chi2 / n) if chi2 > 0 else -math.inf
+        return cls(chi2=chi2, redchi=chi2 / dof if dof > 0 else math.nan,
+                   aic=n * lchi + 2 * n_varys, bic=n * lchi + math.log(n) * n_varys,
+                   sigma=tr75_sigma(data, model, scale, floor),
+                   rms_log=rms_log(data, model, scale), n_points=int(n), n_varys=n_varys)
+
+    @property
+    def dof(self) -> int:
+        """Degrees of freedom ``N - n_varys``."""
+        return self.n_points - self.n_varys
+
+    def as_dict(self) -> dict[str, float | int]:
+        """``{"sigma", "rms_log", "chi2", "redchi", "aic", "bic", "n_points", "n_varys"}``."""
+        return {"sigma": self.sigma, "rms_log": self.rms_log, "chi2": self.chi2,
+                "redchi": self.redchi, "aic": self.aic, "bic": self.bic,
+                "n_points": self.n_points, "n_varys": self.n_varys}
+
+
+@dataclass(frozen=True)
+class Covariance:
+    """Covariance of the fitted parameters (the free ones, then ``"scale"`` if it is free).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> c = Covariance.from_jacobian(np.array([[1.0, 0.0], [0.0, 2.0], [1.0, 2.0]]),
+    ...                              ["a", "b"], chi2=1.0, dof=1)
+    >>> c.stderr().round(6).tolist(), round(c.correl()["a"]["b"], 6)
+    ([0.816497, 0.408248], -0.5)
+    """
+
+    matrix: np.ndarray
+    names: list[str]
+    note: str = ""
+
+    @classmethod
+    def from_jacobian(cls, jmat: np.ndarray, names: list[str], *, chi2: float,
+                      dof: int) -> Covariance:
+        """``(J^T J)^-1 chi2/dof`` through the SVD of ``J``; NaN (and a note) if singular."""
+        p = jmat.shape[1]
+        try:
+            _, s, vt = np.linalg.svd(jmat, full_matrices=False)
+            if not np.all(np.isfinite(s)) or s[0] == 0 or s[-1] <= s[0] * 1e-12:
+                raise np.linalg.LinAlgError("singular")
+            inv = (vt.T / (s * s)) @ vt
+            return cls(inv * (chi2 / max(dof, 1)), names)
+        except np.linalg.LinAlgError:
+            return cls(np.full((p, p), np.nan), names,
+                       "; covariance not estimated (singular J^T J: a parameter has no effect)")
+
+    @classmethod
+    def at_optimum(cls, obj: Objective, theta: np.ndarray, f: np.ndarray, k: float, *,
+                   chi2: float, dof: int) -> Covariance:
+        """From the central-difference Jacobian of ``obj`` at ``theta`` (scale held at ``k``)
+        and, when the scale is free, its analytic column at the model values ``f``."""
+        cols = [obj.jac_central(theta, k)]
+        names = list(obj.spec.free)
+        if obj.spec.free_scale:
+            cols.append(obj.scale_column(f, k)[:, None])
+            names.append("scale")
+        return cls.from_jacobian(np.hstack(cols), names, chi2=chi2, dof=dof)
+
+    def stderr(self) -> np.ndarray:
+        """``sqrt(diag(covar))`` (NaN where not estimable)."""
+        d = np.diag(self.matrix)
+        return np.sqrt(np.where(d >= 0, d, np.nan))
+
+    def correl(self) -> dict[str, dict[str, float]]:
+        """``name -> {other: correlation}``."""
+        sd = self.stderr()
+        with np.errstate(divide="ignore", invalid="ignore"):
+            corr = self.matrix / np.outer(sd, sd)
+        return {a: {b: float(corr[i, m]) for m, b in enumerate(self.names) if m != i}
+                for i, a in enumerate(self.names)}

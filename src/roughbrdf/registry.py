@@ -19,13 +19,13 @@ Examples
 >>> colours.get("rde")
 Traceback (most recent call last):
 ...
-ValueError: unknown colour 'rde'; did you mean 'red', 'rouge'? (known: red)
+ValueError: unknown colour 'rde'; did you mean 'red'? (known: red)
 """
 
 from __future__ import annotations
 
 import difflib
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Mapping
 from typing import Generic, TypeVar
 
 __all__ = ["Registry", "canon", "unknown_name"]
@@ -39,14 +39,22 @@ def canon(name: object) -> str:
 
 
 def unknown_name(kind: str, name: object, known: Iterable[str],
-                 aliases: Iterable[str] = ()) -> ValueError:
+                 aliases: Mapping[str, str] | None = None) -> ValueError:
     """The ``ValueError`` for an unknown ``name`` of ``kind``: lists the ``known`` names and
-    suggests the closest of them and of their ``aliases``."""
+    suggests the closest of them, then the closest ``aliases`` (``{alias: canonical name}``)
+    of any other entry, each with the name it stands for."""
     known = list(known)
-    by_key = {canon(k): k for k in (*aliases, *known)}
-    close = difflib.get_close_matches(canon(name), list(by_key), n=3, cutoff=0.5)
-    hint = f"; did you mean {', '.join(repr(by_key[c]) for c in close)}?" if close else ""
-    return ValueError(f"unknown {kind} {name!r}{hint} (known: {', '.join(known)})")
+    key = canon(name)
+    names = {canon(k): k for k in known}
+    hints = [names[c] for c in difflib.get_close_matches(key, list(names), n=3, cutoff=0.5)]
+    shown = [repr(h) for h in hints]
+    other = {canon(a): c for a, c in (aliases or {}).items() if c not in hints and a not in names}
+    for a in difflib.get_close_matches(key, list(other), n=3, cutoff=0.5):
+        shown.append(f"{a!r} ({other[a]})")
+    shown = shown[:3]
+    hint = f"; did you mean {', '.join(shown)}?" if shown else ""
+    what = kind.replace("{name}", repr(name)) if "{name}" in kind else f"{kind} {name!r}"
+    return ValueError(f"unknown {what}{hint} (known: {', '.join(known)})")
 
 
 class Registry(Generic[T]):
@@ -55,7 +63,8 @@ class Registry(Generic[T]):
     Parameters
     ----------
     kind : str
-        What the entries are, for error messages (``"model"``, ``"distribution"``).
+        What the entries are, for error messages (``"model"``, ``"distribution"``); a
+        ``{name}`` in it marks where the unknown name goes (default: at the end).
     """
 
     def __init__(self, kind: str) -> None:

@@ -76,7 +76,8 @@ TERM_CODES = {None: 0, "surface": 1, "bulk": 2, "retro": 3}
 RETRO_CODES = {"width": 0, "amplitude": 1}  # where the retro V pair acts (_RAMP)
 
 def _option(name: str, values: dict[str, tuple[str, ...]]) -> Registry[str]:
-    reg: Registry[str] = Registry(f"value for option {name!r} of model 'renhorn-boreman-2008'")
+    reg: Registry[str] = Registry(f"value {{name}} for option {name!r} of model "
+                                  "'renhorn-boreman-2008'")
     for canonical, aliases in values.items():
         reg.add(canonical, canonical, aliases)
     return reg

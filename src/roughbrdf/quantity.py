@@ -93,27 +93,41 @@ def relative_scale(data: ArrayLike, model: ArrayLike, *, weights: ArrayLike | No
     >>> relative_scale([2.0, 4.0], [1.0, 2.0], loss="log")
     0.5
     """
-    d = np.asarray(data, dtype=np.float64)
-    f = np.asarray(model, dtype=np.float64)
-    d, f = np.broadcast_arrays(d, f)
-    w2 = np.ones(d.shape) if weights is None else np.broadcast_to(
+    if loss not in LOSSES:
+        raise ValueError(f"loss must be one of {', '.join(LOSSES)}; got {loss!r}")
+    d, f = np.broadcast_arrays(np.asarray(data, dtype=np.float64),
+                               np.asarray(model, dtype=np.float64))
+    w2 = None if weights is None else np.broadcast_to(
         np.asarray(weights, dtype=np.float64) ** 2, d.shape)
-    ok = np.isfinite(d) & np.isfinite(f) & (f > 0) & np.isfinite(w2)
+    ok = np.isfinite(d) & np.isfinite(f) & (f > 0)
+    if w2 is not None:
+        ok &= np.isfinite(w2)
     if loss == "log":
         ok &= d > 0
-    elif loss not in LOSSES:
-        raise ValueError(f"loss must be one of {', '.join(LOSSES)}; got {loss!r}")
-    if not ok.any():
-        return 1.0
-    d, f, w2 = d[ok], f[ok], w2[ok]
+    if not ok.all():  # only usable pairs take part (copies: the common case needs none)
+        if not ok.any():
+            return 1.0
+        d, f = d[ok], f[ok]
+        w2 = None if w2 is None else w2[ok]
+    d, f = d.ravel(), f.ravel()
+    w2 = None if w2 is None else w2.ravel()
+    k = _closed_form(d, f, w2, loss)
+    return k if math.isfinite(k) and k > 0 else 1.0
+
+
+def _closed_form(d: np.ndarray, f: np.ndarray, w2: np.ndarray | None, loss: str) -> float:
+    """The optimum K of :func:`relative_scale` on usable 1-D pairs (dot products: one pass)."""
     if loss == "relative":
         q = d / f
-        den = float((w2 * q * q).sum())
-        k = float((w2 * q).sum()) / den if den > 0 else 1.0
-    elif loss == "absolute":
-        den = float((w2 * d * d).sum())
-        k = float((w2 * d * f).sum()) / den if den > 0 else 1.0
-    else:
-        wsum = float(w2.sum())
-        k = math.exp(float((w2 * (np.log(f) - np.log(d))).sum()) / wsum) if wsum > 0 else 1.0
-    return k if math.isfinite(k) and k > 0 else 1.0
+        wq = q if w2 is None else w2 * q
+        den = float(np.dot(wq, q))
+        return float(wq.sum()) / den if den > 0 else 1.0
+    if loss == "absolute":
+        wd = d if w2 is None else w2 * d
+        den = float(np.dot(wd, d))
+        return float(np.dot(wd, f)) / den if den > 0 else 1.0
+    r = np.log(f) - np.log(d)
+    if w2 is None:
+        return math.exp(float(r.mean()))
+    wsum = float(w2.sum())
+    return math.exp(float(np.dot(w2, r)) / wsum) if wsum > 0 else 1.0

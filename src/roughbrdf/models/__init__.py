@@ -5,13 +5,12 @@
 ``"a+b"``), and one module per model.
 """
 
-from .base import MODELS, Model, PreparedGeometry, register
+from .base import MODELS, Model, PreparedGeometry, SumModel, register
 from .factory import available, model, resolve_names
 from .lambertian import Lambertian
 from .microfacet import Microfacet
 from .parameters import Parameter
 from .renhorn_boreman import RenhornBoreman2008
-from .sum import SumModel
 from .torrance_sparrow import TorranceSparrow1967
 from .trowbridge_reitz import TrowbridgeReitz1975
 

@@ -6,8 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..registry import unknown_name
-from .base import MODELS, Model
-from .sum import SumModel
+from .base import MODELS, Model, SumModel
 
 __all__ = ["available", "model", "resolve_names"]
 

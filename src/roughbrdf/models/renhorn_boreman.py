@@ -103,8 +103,9 @@ OPTION_VALUES: dict[str, Registry[str]] = {
 # --------------------------------------------------------------------------------------------
 # Every part on the hot path is branch-free (selects) and free of libm calls (sincos, vexp,
 # vlog1p and vasin from roughbrdf._kernels.vmath), so that the fast driver's loop vectorizes.
-# ``fast`` (a compile-time constant at each call site) selects the shadowing function: the vectorizable finite sum for integer n <= special.INT_HORNER_MAX, or the
-# general incomplete gamma (series / continued fraction, loops) for any real n.
+# ``fast`` (a compile-time constant at each call site) selects the shadowing function: the
+# vectorizable finite sum for integer n <= special.INT_HORNER_MAX, or the general incomplete
+# gamma (series / continued fraction, loops) for any real n.
 @jit(inline=True)
 def rb08_norm(ci2, a02, rho):
     """Scalar Eq. 6/8 normalization ``N(alpha0, rho)`` from ``ci2 = 1 - alpha0^2``, ``a02``.

@@ -78,7 +78,10 @@ def new_axes(ax: Axes | None = None, *, polar: bool = False,
              figsize: tuple[float, float] = (6.4, 4.8)) -> tuple[Figure, Axes]:
     """Return ``(fig, ax)``: ``ax``'s figure, or a new pyplot-free figure with one axes."""
     if ax is not None:
-        return ax.get_figure(), ax
+        fig = ax.get_figure()
+        if fig is None:  # an axes always belongs to a figure once created
+            raise ValueError("ax must belong to a figure")
+        return fig, ax  # type: ignore[return-value]  # a SubFigure acts as a Figure here
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=figsize, layout="constrained")
@@ -257,13 +260,14 @@ def plot_polar(model: Model, theta_i: float, elevation: float, *, n: int = 361,
     for p, y in curves.items():
         ls, name = styles.get(p, ("-.", f"γ = {p}"))
         ax.plot(psi, y, ls=ls, color="k" if p in ("s", None) else "C3", label=name)
-    ax.set_theta_zero_location("N")  # psi = 0 (toward the source) at the top
-    ax.set_theta_direction(-1)
-    ax.set_thetagrids(range(0, 360, 45))
+    pax: Any = ax  # a PolarAxes (new_axes(polar=True)); typed as Axes
+    pax.set_theta_zero_location("N")  # psi = 0 (toward the source) at the top
+    pax.set_theta_direction(-1)
+    pax.set_thetagrids(range(0, 360, 45))
     ax.yaxis.set_major_locator(MaxNLocator(4))
-    ax.set_rlabel_position(22.5)
+    pax.set_rlabel_position(22.5)
     if rmax is not None:
-        ax.set_rlim(0, rmax)
+        pax.set_rlim(0, rmax)
     ax.set_xlabel(r"azimuth $\psi$ (0° toward the source) [deg]", labelpad=4)
     ax.set_ylabel(r"BRIDF [sr$^{-1}$]", labelpad=28)
     head = f"{label}: " if label else ""
@@ -305,7 +309,7 @@ def plot_hemisphere(model: Model, theta_i: float, *, quantity: str = "brdf", log
     pos = Z[np.isfinite(Z) & (Z > 0)]
     if log and pos.size:
         lo = vmin if vmin is not None else max(pos.min(), pos.max() * 1e-4)
-        norm = mcolors.LogNorm(vmin=lo, vmax=vmax if vmax is not None else pos.max())
+        norm: Any = mcolors.LogNorm(vmin=lo, vmax=vmax if vmax is not None else pos.max())
         Z = np.where(Z > 0, Z, np.nan)
     else:
         norm = mcolors.Normalize(vmin=vmin, vmax=vmax)
@@ -368,7 +372,7 @@ def _pol_groups(meas: Measurement) -> list[tuple[Any, np.ndarray, str]]:
     """Split samples by incident polarization: ``[(pol, mask, label)]``."""
     if meas.polarization is None or np.all(np.isnan(meas.polarization)):
         return [(None, np.ones(meas.n_samples, bool), "")]
-    out = []
+    out: list[tuple[float | None, np.ndarray, str]] = []
     g = np.round(meas.polarization, 9)
     if np.isnan(g).any():
         out.append((None, np.isnan(g), " unpol."))

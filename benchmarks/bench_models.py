@@ -2,9 +2,16 @@
 
 Inputs are NumPy angle arrays (structure of arrays: ``theta_i``, ``theta_r``, ``phi``), as a
 user passes them; the time includes validation and the output allocation. Each model is run at
-its default parameters, unpolarized, ``brdf()``. Alongside, a plain vectorized-NumPy
-implementation of TR75 (written here, independently of the library, as the reference) is timed
-in the same run, and the speed-up of the compiled kernel over it is printed.
+its default parameters, unpolarized, ``brdf()``; the microfacet model also with the Beckmann
+distribution (its other defaults: Smith height-correlated, Fresnel n = 1.5). Alongside, a plain
+vectorized-NumPy implementation of TR75 (written here, independently of the library, as the
+reference) is timed in the same run, and the speed-up of the compiled kernel over it is printed.
+
+The models are timed *interleaved* (one call of each in turn, ``REPEAT`` rounds, the best
+round kept per model), so that every model sees the same machine load; the ratio of each
+model's rate to TR75's in the same run is printed with it, and so are the CPU time per
+evaluation (all threads together; less sensitive to other processes than wall time) and the
+load average before and after.
 
 Run with ``make bench`` (all benchmarks) or ``python benchmarks/bench_models.py``.
 Figures are recorded in ``docs/benchmarks.md``.
@@ -21,7 +28,7 @@ import numpy as np
 import roughbrdf as rb
 
 N = 1_000_000
-REPEAT = 7
+REPEAT = 15  # interleaved rounds; the best round per model is kept
 TR75_PARAMS = {"e": 0.68, "n": 1.0, "k": 0.9, "rho_L": 0.33}  # TR75 Table 1, cement
 
 
@@ -49,17 +56,6 @@ def tr75_numpy(theta_i, theta_r, phi, e, n, k, rho_L):  # noqa: N803 - paper's s
     return bridf_s / cr + rho_L / math.pi
 
 
-def _best(fn, repeat: int = REPEAT) -> float:
-    """Smallest wall time of ``repeat`` calls (after one warm-up call), seconds."""
-    fn()
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
-
-
 def geometries(n: int = N, seed: int = 20250101) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Random geometries on the hemisphere (theta_i < 89.9 deg so every model is defined)."""
     rng = np.random.default_rng(seed)
@@ -69,52 +65,81 @@ def geometries(n: int = N, seed: int = 20250101) -> tuple[np.ndarray, np.ndarray
     return theta_i, theta_r, phi
 
 
+def _rows() -> list[tuple[str, object]]:
+    """(label, model) per benchmark row: every registered model, plus Beckmann microfacet."""
+    rows = []
+    for name in rb.available():
+        m = rb.model(name, **(TR75_PARAMS if name == "trowbridge-reitz-1975" else {}))
+        label = name
+        if name == "microfacet":  # GGX and Beckmann, each with its default Smith and Fresnel
+            for mm in (m, rb.model("microfacet", distribution="beckmann")):
+                short = {"trowbridge-reitz": "ggx", "smith-height-correlated": "smith-hc",
+                         "smith-separable": "smith-sep"}
+                o = mm.options
+                d, sh = short.get(o["distribution"], o["distribution"]), o["shadowing"]
+                rows.append((f"microfacet ({d}, {short.get(sh, sh)}, fresnel)", mm))
+            continue
+        rows.append((label, m))
+    return rows
+
+
+def _load() -> str:
+    try:
+        return "/".join(f"{x:.2f}" for x in os.getloadavg())
+    except OSError:  # pragma: no cover - not on every platform
+        return "?"
+
+
 def main() -> dict[str, float]:
-    """Print and return evaluations/s per model, the NumPy reference, and the TR75 speed-up."""
+    """Print and return evaluations/s per model, the ratios to TR75, the NumPy reference and
+    the TR75 speed-up (all from one interleaved run)."""
     import numba
 
     ti, tr, phi = geometries()
-    print(f"{N:.0e} random geometries, float64, unpolarized brdf(); best of {REPEAT}; "
-          f"{numba.get_num_threads()} Numba threads")
-    print(f"{'model':<28} {'evaluations/s':>14}")
-    rates: dict[str, float] = {}
-    for name in rb.available():
-        m = rb.model(name, **(TR75_PARAMS if name == "trowbridge-reitz-1975" else {}))
-        rates[name] = N / _best(lambda m=m: m.brdf(ti, tr, phi))
-        print(f"{name:<28} {rates[name]:>14.3e}")
-    # TR75 compiled vs NumPy, interleaved so that both see the same machine load
-    tr75 = rb.model("trowbridge-reitz-1975", **TR75_PARAMS)
-    t_fast, t_ref, c_fast, c_ref = [], [], [], []
+    rows = _rows()
+    tr75 = next(m for label, m in rows if label == "trowbridge-reitz-1975")
+    calls = [(label, (lambda m=m: m.brdf(ti, tr, phi))) for label, m in rows]
+    calls.append(("tr75 (plain NumPy reference)",
+                  lambda: tr75_numpy(ti, tr, phi, **TR75_PARAMS)))
+    load_before = _load()
+    print(f"{N:.0e} random geometries, float64, unpolarized brdf(); {REPEAT} interleaved rounds, "
+          f"best per model; {numba.get_num_threads()} Numba threads; load average (1/5/15 min) "
+          f"before: {load_before}")
+    for _, fn in calls:  # warm-up: compile or load from the disk cache
+        fn()
+    wall: dict[str, list[float]] = {label: [] for label, _ in calls}
+    cpu: dict[str, list[float]] = {label: [] for label, _ in calls}
     for _ in range(REPEAT):
-        for fn, wall, cpu in ((lambda: tr75.brdf(ti, tr, phi), t_fast, c_fast),
-                              (lambda: tr75_numpy(ti, tr, phi, **TR75_PARAMS), t_ref, c_ref)):
-            fn()
+        for label, fn in calls:
             w0, c0 = time.perf_counter(), time.process_time()
             fn()
-            cpu.append(time.process_time() - c0)
-            wall.append(time.perf_counter() - w0)
-    rates["trowbridge-reitz-1975"] = max(rates["trowbridge-reitz-1975"], N / min(t_fast))
-    ref = N / min(t_ref)
-    rates["tr75-numpy-reference"] = ref
-    print(f"{'tr75 (plain NumPy reference)':<28} {ref:>14.3e}")
-    # the two implementations must agree, or the comparison means nothing
+            cpu[label].append(time.process_time() - c0)
+            wall[label].append(time.perf_counter() - w0)
+    rates = {label: N / min(t) for label, t in wall.items()}
+    ref_label = "trowbridge-reitz-1975"
+    cpu_ns = {label: min(t) / N * 1e9 for label, t in cpu.items()}
+    print(f"{'model':<46} {'evaluations/s':>13} {'/ TR75':>7} {'CPU ns/eval':>11} "
+          f"{'TR75 CPU / CPU':>14}")
+    for label, _ in calls:
+        print(f"{label:<46} {rates[label]:>13.3e} {rates[label] / rates[ref_label]:>7.2f} "
+              f"{cpu_ns[label]:>11.1f} {cpu_ns[ref_label] / cpu_ns[label]:>14.2f}")
+    # the two TR75 implementations must agree, or the comparison means nothing
     fast = tr75.brdf(ti, tr, phi)
     slow = tr75_numpy(ti, tr, phi, **TR75_PARAMS)
     err = float(np.max(np.abs(fast - slow) / np.abs(slow)))
-    speedup = rates["trowbridge-reitz-1975"] / ref
-    rates["tr75-speedup"] = speedup
-    print(f"TR75 compiled: {rates['trowbridge-reitz-1975']:.3e} evaluations/s, "
-          f"{speedup:.1f}x the NumPy reference (max relative difference {err:.1e})")
-    # CPU time (all threads) is less sensitive to other processes than wall time
-    print(f"CPU time per evaluation: TR75 compiled {min(c_fast) / N * 1e9:.1f} ns, NumPy "
-          f"{min(c_ref) / N * 1e9:.1f} ns ({min(c_ref) / min(c_fast):.1f}x less work)")
-    try:
-        load = os.getloadavg()[0]
-        print(f"load average during the run: {load:.2f} on {os.cpu_count()} cores "
-              "(other processes slow the 2-thread kernel more than single-threaded NumPy)")
-    except OSError:  # pragma: no cover - not on every platform
-        pass
-    return rates
+    ref = rates["tr75 (plain NumPy reference)"]
+    speedup = rates[ref_label] / ref
+    print(f"TR75 compiled: {rates[ref_label]:.3e} evaluations/s, {speedup:.1f}x the NumPy "
+          f"reference (max relative difference {err:.1e}); CPU time "
+          f"{min(cpu['tr75 (plain NumPy reference)']) / min(cpu[ref_label]):.1f}x less")
+    print(f"load average after: {_load()} on {os.cpu_count()} cores (other processes slow the "
+          "2-thread kernels more than single-threaded NumPy)")
+    out = {label: rates[label] for label, _ in calls}
+    out["tr75-numpy-reference"] = ref
+    out["tr75-speedup"] = speedup
+    for label, _ in calls:
+        out[f"{label} / tr75"] = rates[label] / rates[ref_label]
+    return out
 
 
 if __name__ == "__main__":

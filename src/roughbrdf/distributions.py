@@ -35,8 +35,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .registry import Registry
 from ._kernels import as_float_array, jit, ufunc
+from ._kernels.vmath import vacos, verfc, vexp, vlog
+from .registry import Registry
 
 __all__ = [
     "Distribution",
@@ -117,7 +118,10 @@ def check_param(code: int, value: float, name: str = "") -> None:
 # --------------------------------------------------------------------------------------------
 # scalar parts
 # --------------------------------------------------------------------------------------------
-@jit
+# Inlined (``@jit(inline=True)``) and free of libm calls (exp, log and acos from
+# roughbrdf._kernels.vmath), so that the model loops that call them vectorize; with a literal
+# ``code`` (the model drivers) the other distributions' branches compile away.
+@jit(inline=True)
 def peak(code, c, a):
     """Peak-normalized shape ``P`` at ``cos theta_h = c`` for distribution ``code``, width ``a``."""
     c = min(1.0, max(0.0, c))
@@ -128,21 +132,25 @@ def peak(code, c, a):
     if code == BERRY:
         return a * a / (a * a * c * c + s2)
     if code == GAUSS_ANGLE:
-        x = a * math.acos(c) * _DEG
-        return math.exp(-x * x)
-    if c < 1e-150:
-        # Beckmann/Sirohi: exp(-A tan^2) beats any power of 1/cos at grazing; the limit is 0
-        # (and tan^2 > 1e300 here: the value underflows for every width parameter in range).
-        return 0.0
+        x = a * vacos(c) * _DEG
+        return vexp(-x * x)
+    # Beckmann/Sirohi: exp(-A tan^2) beats any power of 1/cos at grazing, the limit is 0; below
+    # c = 1e-150, tan^2 > 1e300 and the value underflows for every width parameter in range.
+    # (cc: a stand-in on those lanes, so that nothing below divides by 0 or takes log(0).)
+    grazing = c < 1e-150
+    cc = 1.0 if grazing else c
+    t2 = s2 / (cc * cc)
     # exp(-x tan^2) / cos^p as one exponential: for tiny c, cos^p underflows to 0 (0/0 in the
     # quotient) while the exponent goes to -inf first, so the log form gives the limit 0.
-    t2 = s2 / (c * c)
+    lc = vlog(cc)
     if code == BECKMANN:
-        return math.exp(-t2 / (a * a) - 4.0 * math.log(c))
-    return math.exp(-a * t2 - 2.0 * math.log(c))  # SIROHI
+        v = vexp(-t2 / (a * a) - 4.0 * lc)
+    else:  # SIROHI
+        v = vexp(-a * t2 - 2.0 * lc)
+    return 0.0 if grazing else v
 
 
-@jit
+@jit(inline=True)
 def lambda_cos(code, c, a):
     """Smith ``Lambda(theta) * cos(theta)`` at ``cos theta = c`` (finite at grazing).
 
@@ -154,12 +162,14 @@ def lambda_cos(code, c, a):
     s = math.sqrt(1.0 - c * c)
     if code == TR:
         return 0.5 * (math.sqrt(c * c + a * a * s * s) - c)
-    # BECKMANN
-    if s == 0.0:
-        return 0.0  # normal direction: no masking, Lambda = 0
-    u = c / (a * s)
+    # BECKMANN, u = c/(a s). a s = 0 (s = 0, the normal direction, or a s underflowing):
+    # u = inf, no masking, Lambda = 0 (returned below). The stand-in denominator keeps that
+    # lane free of a division by 0, whose flag the ufunc front ends would report as a warning.
+    den = a * s
+    u = c / (den if den > 0.0 else 1.0)
     # erfc instead of erf - 1 (no cancellation); Lambda >= 0, so clip the round-off below 0
-    return max(0.0, 0.5 * a * s * math.exp(-u * u) / _SQRT_PI - 0.5 * c * math.erfc(u))
+    lam = max(0.0, 0.5 * den * vexp(-u * u) / _SQRT_PI - 0.5 * c * verfc(u))
+    return lam if den > 0.0 else 0.0
 
 
 @ufunc(3)
@@ -209,7 +219,7 @@ def trowbridge_reitz_d(c, e):
     return e * e / (math.pi * q * q)
 
 
-@jit
+@jit(inline=True)
 def evaluate_d(code, c, a, norm):
     """Scalar part: normalized ``D = norm * P(c)`` (``norm`` from :func:`normalization`)."""
     return norm * peak(code, c, a)

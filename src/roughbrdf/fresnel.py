@@ -102,7 +102,7 @@ def fresnel_polarized_cs(c, n, k, gamma, cos_eta, sin_eta):
     return 0.5 * (rs + rp) if unpolarized else pol
 
 
-@jit
+@jit(inline=True)
 def fresnel_polarized(c, n, k, gamma, eta):
     """Scalar part of TR75 Eq. 24: reflectance for incident polarization angle ``gamma``.
 

@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._kernels import SINCOS_MAX_ARG, TINY, as_float_array, jit, sincos, ufunc
+from ._kernels.vmath import vatan2
 
 HALF_PI = 0.5 * math.pi
 
@@ -147,7 +148,8 @@ def half_vector(ti, tr, phi):
         # direction, G = 0 at grazing incidence). Return a horizontal "half vector" with
         # cos_d = 0, so that every model gives its shadowed limit (nothing reflects) there.
         return 1.0, 0.0, 0.0, 0.0, ci, cr, si
-    inv = 1.0 / (length + TINY)  # TINY: see roughbrdf._kernels.vmath.TINY (compiled code runs both sides)
+    # TINY: see roughbrdf._kernels.vmath.TINY (compiled code runs both sides of the branch)
+    inv = 1.0 / (length + TINY)
     return sx * inv, sy * inv, sz * inv, 0.5 * length, ci, cr, si
 
 
@@ -172,15 +174,16 @@ def ts67_projected(ti, tr, phi):
     inv = 1.0 / (hxy + TINY)
     ux = hx * inv if tilted else 1.0
     uy = hy * inv if tilted else 0.0
-    alpha = math.atan2(hxy, hz)  # = acos(hz), without acos's sqrt(eps) error near alpha = 0
-    a_i = math.atan2(-si * ux, ci)
-    a_r = math.atan2(wrx * ux + wry * uy, cr)
+    # vatan2: the vectorizable atan2 (roughbrdf._kernels.vmath), <= 1 ulp
+    alpha = vatan2(hxy, hz)  # = acos(hz), without acos's sqrt(eps) error near alpha = 0
+    a_i = vatan2(-si * ux, ci)
+    a_r = vatan2(wrx * ux + wry * uy, cr)
     if a_i <= 0.0:
         return -a_i, a_r, alpha
     return a_i, -a_r, -alpha
 
 
-@jit
+@jit(inline=True)
 def tr75_eta_from_h(si, ci, hx, hy, hz):
     """TR75 angle eta between the local and the macroscopic planes of incidence (Eq. 23).
 
@@ -188,11 +191,12 @@ def tr75_eta_from_h(si, ci, hx, hy, hz):
     ``cos eta sin s = (w_i x h)_y = sin(theta_i) h_z + cos(theta_i) h_x``
     (MODELS.md §3.5, recommended sign). At ``s = 0`` both vanish and eta = 0 (R_s = R_p
     there); below ``sin s = 1e-12`` the two are round-off, and eta = 0 is returned too.
+    Vectorizable (:func:`roughbrdf._kernels.vmath.vatan2`); the model kernels use the cheaper
+    :func:`tr75_eta_xy` instead of the angle.
     """
     x = si * hz + ci * hx
-    if x * x + hy * hy < 1e-24:
-        return 0.0
-    return math.atan2(hy, x)
+    eta = vatan2(hy, x)
+    return 0.0 if x * x + hy * hy < 1e-24 else eta
 
 
 @jit(inline=True)

@@ -30,17 +30,20 @@ Smith
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from . import distributions as _dist
 from . import special as _special
-from .registry import Registry
 from ._kernels import TINY, as_float_array, jit, ufunc
 from .geometry import check_angles, half_vector, ts67_projected
+from .registry import Registry
 
 __all__ = [
+    "Shadowing",
+    "SHADOWING",
     "NONE",
     "V_GROOVE",
     "SMITH_SEPARABLE",
@@ -62,13 +65,34 @@ __all__ = [
 ]
 
 NONE, V_GROOVE, SMITH_SEPARABLE, SMITH_HEIGHT_CORRELATED = 0, 1, 2, 3
-#: shadowing codes by canonical name and alias (:class:`roughbrdf.registry.Registry`)
-SHADOWING: Registry[int] = Registry("shadowing")
-SHADOWING.add("none", NONE, ("no", "off"))
-SHADOWING.add("v-groove", V_GROOVE, ("torrance-sparrow", "ts67", "v-cavity"))
-SHADOWING.add("smith-separable", SMITH_SEPARABLE, ("smith-uncorrelated",))
-SHADOWING.add("smith-height-correlated", SMITH_HEIGHT_CORRELATED, ("smith",))
-_CANONICAL = {code: name for name in SHADOWING for code in (SHADOWING.get(name),)}
+
+
+@dataclass(frozen=True)
+class Shadowing:
+    """A registered shadowing function: its canonical name and the code the kernels take."""
+
+    name: str
+    code: int
+    description: str
+    reference: str
+    aliases: tuple[str, ...] = ()
+
+
+_ENTRIES = [
+    Shadowing("none", NONE, "no shadowing or masking, G = 1", "", ("no", "off")),
+    Shadowing("v-groove", V_GROOVE, "V-groove (V-cavity) geometrical attenuation factor",
+              "Torrance & Sparrow 1967, Table I", ("torrance-sparrow", "ts67", "v-cavity")),
+    Shadowing("smith-separable", SMITH_SEPARABLE, "Smith G1(i) G1(r), uncorrelated",
+              "Smith 1967; Heitz 2014, Eq. 98", ("smith-uncorrelated",)),
+    Shadowing("smith-height-correlated", SMITH_HEIGHT_CORRELATED,
+              "Smith height-correlated 1/(1 + Lambda(i) + Lambda(r))", "Heitz 2014, Eqs. 98-99",
+              ("smith",)),
+]
+
+#: every shadowing function by canonical name and alias (:class:`roughbrdf.registry.Registry`)
+SHADOWING: Registry[Shadowing] = Registry("shadowing")
+for _s in _ENTRIES:
+    SHADOWING.add(_s.name, _s, _s.aliases)
 
 
 def names() -> list[str]:
@@ -76,14 +100,14 @@ def names() -> list[str]:
     return SHADOWING.names()
 
 
-def get(name: str | None) -> int:
-    """Code of a shadowing function by name or alias (``None`` means ``"none"``)."""
-    return NONE if name is None else SHADOWING.get(name)
+def get(name: str | None) -> Shadowing:
+    """A shadowing function by name or alias (``None`` means ``"none"``)."""
+    return SHADOWING.get("none" if name is None else name)
 
 
-def canonical(code: int) -> str:
-    """Canonical name of a shadowing code."""
-    return _CANONICAL[code]
+def canonical(code: int | Shadowing) -> str:
+    """Canonical name of a shadowing entry or code."""
+    return _ENTRIES[code.code if isinstance(code, Shadowing) else int(code)].name
 
 
 # --------------------------------------------------------------------------------------------
@@ -100,7 +124,7 @@ def v_groove_g(ci, cr, ch, cd):
     """Scalar TS67 V-groove G from cosines (closed form, MODELS.md §2.5)."""
     if cd <= 0.0:
         return 0.0  # w_i = -w_r (grazing, opposite): nothing reflects
-    # + TINY: compiled code may evaluate this side also when cd = 0 (see roughbrdf._kernels.vmath.TINY)
+    # + TINY: compiled code may evaluate this side also when cd = 0 (roughbrdf._kernels.vmath.TINY)
     return min(1.0, 2.0 * ch * cr / (cd + TINY), 2.0 * ch * ci / (cd + TINY))
 
 
@@ -108,36 +132,45 @@ def v_groove_g(ci, cr, ch, cd):
 def v_groove_g_over_cos_r(ci, cr, ch, cd):
     """Scalar ``G/cos(theta_r)`` per branch (TS67; finite at theta_r = 90 deg, MODELS.md §2.5).
 
-    G = 1: ``1/cos theta_r``; masking: ``2 cos theta_h/cos theta_d`` (no division by
-    cos theta_r); shadowing: ``2 cos theta_h cos theta_i/(cos theta_d cos theta_r)``.
+    With ``m = 2 cos theta_h/cos theta_d``, ``G = min(1, m cos theta_r, m cos theta_i)``, so
+    ``G/cos theta_r`` is, per branch: G = 1: ``1/cos theta_r``; masking (``cr <= ci``): ``m``
+    (no division by cos theta_r); shadowing: ``m cos theta_i/cos theta_r``. The branch is
+    picked by comparing products (G = 1 iff ``cd <= 2 ch min(ci, cr)``) and the chosen
+    quotient formed with one division: vectorizable and cheaper than the minimum of the three
+    quotients, which it equals to rounding (the candidates meet continuously at the branch
+    boundaries).
     """
-    if cd <= 0.0:
-        return 0.0
-    masking = 2.0 * ch / (cd + TINY)  # + TINY: see roughbrdf._kernels.vmath.TINY
-    if cr <= 0.0:
-        return masking  # the G=1 and shadowing candidates are +inf at theta_r = 90 deg
-    inv_cr = 1.0 / (cr + TINY)
-    return min(inv_cr, masking, masking * ci * inv_cr)
+    g1 = cd <= 2.0 * ch * min(ci, cr)  # G = 1 (the cd <= 0 lanes are replaced by 0 below)
+    masking = cr <= ci
+    num = 1.0 if g1 else (2.0 * ch if masking else 2.0 * ch * ci)
+    den = cr if g1 else (cd if masking else cd * cr)
+    # den > 0 on every lane used (g1 needs cr > 0, shadowing cr > ci >= 0); the stand-in 1
+    # keeps the cd <= 0 lanes (w_i = -w_r, nothing reflects: 0) free of a division by 0
+    q = num / (den if den > 0.0 else 1.0)
+    return q if cd > 0.0 else 0.0
 
 
 @jit(inline=True)
 def v_groove_g_over_cos_cos(ci, cr, ch, cd):
     """Scalar TS67 ``G/(cos theta_i cos theta_r)`` per branch (microfacet and absolute forms).
 
-    G is symmetric in (i, r), so ``G/cos`` of the *smaller* cosine is a per-branch quotient
-    that stays finite (:func:`v_groove_g_over_cos_r` with the arguments in either order), and
-    only the larger cosine is divided by. Finite unless both directions are exactly grazing,
-    where the limit is ``inf`` (0 if nothing reflects, ``cd = 0``).
+    ``G/(ci cr) = min(1/(ci cr), m/ci, m/cr) = min(1/(ci cr), m/max(ci, cr))`` with
+    ``m = 2 cos theta_h/cos theta_d``: the G = 1 branch (``cd <= 2 ch min(ci, cr)``) gives
+    ``1/(ci cr)``, the others ``2 ch/(cd max(ci, cr))``, which divides only by the larger
+    cosine and stays finite when the smaller one is 0. Symmetric in (i, r); one division.
+    Finite unless both directions are exactly grazing, where the limit is ``inf`` (0 if
+    nothing reflects, ``cd = 0`` or ``ch = 0``).
     """
-    if ci >= cr:
-        g_c = v_groove_g_over_cos_r(ci, cr, ch, cd)  # G / cos(theta_r)
-        big = ci
-    else:
-        g_c = v_groove_g_over_cos_r(cr, ci, ch, cd)  # G / cos(theta_i), by symmetry
-        big = cr
-    if big > 0.0:
-        return g_c / (big + TINY)
-    return math.inf if g_c > 0.0 else 0.0
+    small = min(ci, cr)
+    big = max(ci, cr)
+    g1 = cd <= 2.0 * ch * small  # G = 1 (the cd <= 0 lanes are replaced by 0 below)
+    num = 1.0 if g1 else 2.0 * ch
+    den = small * big if g1 else cd * big
+    # den = 0: both directions grazing (big = 0), the limit inf of a positive numerator; the
+    # stand-in 1 keeps that lane free of a division by 0
+    q = num / (den if den > 0.0 else 1.0)
+    q = q if den > 0.0 else (math.inf if num > 0.0 else 0.0)
+    return q if cd > 0.0 else 0.0  # w_i = -w_r (grazing, opposite): nothing reflects
 
 
 @jit
@@ -179,7 +212,7 @@ def v_groove_table_g(psi_p, theta_p):
     return 1.0
 
 
-@jit
+@jit(inline=True)
 def smith_g_over_cos_cos(code, dcode, a, ci, cr):
     """Scalar Smith ``G/(cos theta_i cos theta_r)`` (finite at grazing).
 
@@ -192,17 +225,20 @@ def smith_g_over_cos_cos(code, dcode, a, ci, cr):
         den = (ci + li) * (cr + lr)
     else:
         den = ci * cr + cr * li + ci * lr
-    if den <= 0.0:
-        return 0.0  # both directions exactly grazing: fully masked
-    return 1.0 / den
+    # den <= 0: both directions exactly grazing, fully masked (0); the stand-in 1 keeps that
+    # lane free of a division by 0 (compiled code computes both sides of the select)
+    q = 1.0 / (den if den > 0.0 else 1.0)
+    return q if den > 0.0 else 0.0
 
 
-@jit
+@jit(inline=True)
 def g_over_cos_cos(code, dcode, a, ci, cr, ch, cd):
     """Scalar ``G/(cos theta_i cos theta_r)`` for shadowing ``code`` (NONE gives 1/(ci cr))."""
     if code == NONE:
         den = ci * cr
-        return 1.0 / den if den > 0.0 else math.inf  # the no-shadowing form diverges: limit inf
+        # the no-shadowing form diverges at grazing: limit inf (stand-in 1: no division by 0)
+        q = 1.0 / (den if den > 0.0 else 1.0)
+        return q if den > 0.0 else math.inf
     if code == V_GROOVE:
         return v_groove_g_over_cos_cos(ci, cr, ch, cd)
     return smith_g_over_cos_cos(code, dcode, a, ci, cr)
@@ -280,7 +316,7 @@ def smith(theta_i: ArrayLike, theta_r: ArrayLike, alpha: float,
           distribution: str = "trowbridge-reitz", kind: str = "smith-height-correlated"
           ) -> np.ndarray:
     """Smith bidirectional G, separable or height-correlated (``kind``)."""
-    code = get(kind)
+    code = get(kind).code
     if code not in (SMITH_SEPARABLE, SMITH_HEIGHT_CORRELATED):
         raise ValueError(f"kind must be a Smith variant, got {kind!r}")
     d = _dist.get(distribution)

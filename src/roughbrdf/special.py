@@ -29,23 +29,20 @@ Write ``Q(a, x) = 1 - P(a, x)`` and ``x^a e^-x/Γ(a)`` for the common prefactor.
 
 Vectorizable parts
 ------------------
-:func:`gammaincc_int` (integer ``a <= 17``, a fixed-length masked Horner sum) and the
-branch-free :func:`vexp`, :func:`vlog`, :func:`vlog1p`, :func:`vasin` exist so that the RB08
-model loop vectorizes (see the section comment below).
+:func:`gammaincc_int` (integer ``a <= 17``, a fixed-length masked Horner sum) exists so that
+the RB08 model loop vectorizes. The branch-free :func:`vexp`, :func:`vlog`, :func:`vlog1p`,
+:func:`vasin` it uses are defined in :mod:`roughbrdf._kernels.vmath` and re-exported here.
 """
 
 from __future__ import annotations
 
 import math
-import struct
 
 import numpy as np
-from llvmlite import ir
-from numba import types
-from numba.extending import intrinsic
 from numpy.typing import ArrayLike
 
-from ._kernels import DISABLE_JIT, as_float_array, jit, ufunc
+from ._kernels import as_float_array, jit, ufunc
+from ._kernels.vmath import _f2i, _i2f, vasin, vexp, vlog, vlog1p  # noqa: F401 - re-exported
 
 __all__ = ["gammaincc", "gammaincc_q", "gammaincc_int", "stirlerr", "bd0", "FINITE_SUM_MAX",
            "INT_HORNER_MAX", "vexp", "vlog", "vlog1p", "vasin"]
@@ -201,169 +198,11 @@ def gammaincc(a: ArrayLike, x: ArrayLike) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------------------------
-# branch-free exp, log, log1p, asin and integer-a Q that LLVM can vectorize
+# integer-a Q that LLVM can vectorize
 # --------------------------------------------------------------------------------------------
-# Why hand-written: Numba's LLVM has no vector math library here (no SVML), so a loop calling
-# math.exp/log/asin stays scalar (see roughbrdf._kernels.vmath). These are written with selects instead
-# of branches and without libm calls, so a model loop that uses them vectorizes (the RB08 fast
-# path). Argument reductions and the log/asin coefficients are fdlibm's (e_log.c, e_asin.c);
-# exp uses a degree-13 Taylor polynomial (no division). Accuracy is tested against NumPy
-# (1-2 ulp). The bit manipulations use two bit-cast intrinsics (struct-based pure Python under
-# NUMBA_DISABLE_JIT=1).
-
-if DISABLE_JIT:
-
-    def _f2i(x):
-        """Bits of a float64 as int64."""
-        return struct.unpack("<q", struct.pack("<d", float(x)))[0]
-
-    def _i2f(i):
-        """int64 bits as a float64."""
-        return struct.unpack("<d", struct.pack("<q", int(i)))[0]
-
-else:
-
-    @intrinsic
-    def _f2i(typingctx, x):  # pragma: no cover - compiled
-        if not isinstance(x, types.Float):
-            return None
-
-        def codegen(context, builder, signature, args):
-            return builder.bitcast(args[0], ir.IntType(64))
-
-        return types.int64(types.float64), codegen
-
-    @intrinsic
-    def _i2f(typingctx, i):  # pragma: no cover - compiled
-        if not isinstance(i, types.Integer):
-            return None
-
-        def codegen(context, builder, signature, args):
-            return builder.bitcast(args[0], ir.DoubleType())
-
-        return types.float64(types.int64), codegen
-
-
-_INVLN2 = 1.44269504088896338700e00
-_LN2HI = 6.93147180369123816490e-01
-_LN2LO = 1.90821492927058770002e-10
-_EXP_TAYLOR = tuple(1.0 / math.factorial(k) for k in range(14))  # e^r, |r| <= ln2/2: 1 ulp
-
-
-@jit(inline=True)
-def vexp(x):
-    """``exp(x)``, branch-free: ``x = k ln2 + r`` (fdlibm's two-part ln2), ``e^r`` by its Taylor
-    polynomial of degree 13 (FMAs only, no division; <= 1 ulp on ``|r| <= ln2/2``).
-
-    Correct over the whole float range: overflow to inf above 709.78, gradual underflow to 0
-    below -708, NaN in gives NaN.
-    """
-    nan = x != x
-    xc = min(max(0.0 if nan else x, -746.0), 710.0)  # clamped: k stays in the exponent range
-    k = math.floor(xc * _INVLN2 + 0.5)
-    r = (xc - k * _LN2HI) - k * _LN2LO
-    y = _EXP_TAYLOR[13]
-    for j in range(12, -1, -1):
-        y = y * r + _EXP_TAYLOR[j]
-    ki = int(k)
-    k1 = ki >> 1  # 2^k = 2^k1 2^k2, each a normal number for k in [-1076, 1024]
-    k2 = ki - k1
-    res = y * _i2f((k1 + 1023) << 52) * _i2f((k2 + 1023) << 52)
-    return math.nan if nan else res
-
-
-_LG1 = 6.666666666666735130e-01
-_LG2 = 3.999999999940941908e-01
-_LG3 = 2.857142874366239149e-01
-_LG4 = 2.222219843214978396e-01
-_LG5 = 1.818357216161805012e-01
-_LG6 = 1.531383769920937332e-01
-_LG7 = 1.479819860511658591e-01
-_SQRT2 = 1.4142135623730951
-_TINY_NORMAL = 2.2250738585072014e-308
-_MANT_MASK = 0x000FFFFFFFFFFFFF
-_ONE_BITS = 0x3FF0000000000000
-
-
-@jit(inline=True)
-def vlog(x):
-    """Natural ``log(x)``, branch-free (fdlibm: ``x = 2^k m``, ``m`` in [sqrt(2)/2, sqrt(2))).
-
-    ``log(0) = -inf``, ``log(inf) = inf``, negative or NaN gives NaN; subnormals are handled.
-    """
-    special_ = not (x > 0.0) or x == math.inf
-    xx = 1.0 if special_ else x
-    sub = xx < _TINY_NORMAL
-    xx = xx * 18014398509481984.0 if sub else xx  # 2^54: subnormals become normal
-    bits = _f2i(xx)
-    k = (bits >> 52) - 1023
-    m = _i2f((bits & _MANT_MASK) | _ONE_BITS)  # mantissa in [1, 2)
-    big = m > _SQRT2
-    m = 0.5 * m if big else m
-    kf = float(k) + (1.0 if big else 0.0) - (54.0 if sub else 0.0)
-    f = m - 1.0
-    s = f / (2.0 + f)
-    z = s * s
-    w = z * z
-    t1 = w * (_LG2 + w * (_LG4 + w * _LG6))
-    t2 = z * (_LG1 + w * (_LG3 + w * (_LG5 + w * _LG7)))
-    hfsq = 0.5 * f * f
-    res = kf * _LN2HI - ((hfsq - (s * (hfsq + t1 + t2) + kf * _LN2LO)) - f)
-    if special_:
-        res = math.inf if x == math.inf else (-math.inf if x == 0.0 else math.nan)
-    return res
-
-
-@jit(inline=True)
-def vlog1p(t):
-    """``log(1 + t)`` for ``t >= -1`` without cancellation: ``log(u) t/(u - 1)``, ``u = 1 + t``.
-
-    (The classic correction: ``u - 1`` is the exactly representable part of ``t`` that ``u``
-    keeps, so the ratio repairs the rounding of ``1 + t``; a few ulp.)
-    """
-    u = 1.0 + t
-    d = u - 1.0
-    res = vlog(u) * (t / (d if d != 0.0 else 1.0))
-    res = t if d == 0.0 else res
-    return math.inf if t == math.inf else res
-
-
-_PS0 = 1.66666666666666657415e-01
-_PS1 = -3.25565818622400915405e-01
-_PS2 = 2.01212532134862925881e-01
-_PS3 = -4.00555345006794114027e-02
-_PS4 = 7.91534994289814532176e-04
-_PS5 = 3.47933107596021167570e-05
-_QS1 = -2.40339491173441421878e00
-_QS2 = 2.02094576023350569471e00
-_QS3 = -6.88283971605453293030e-01
-_QS4 = 7.70381505559019352791e-02
-_PIO2_HI = 1.57079632679489655800e00
-_PIO2_LO = 6.12323399573676603587e-17
-
-
-@jit(inline=True)
-def _asin_r(t):
-    p = t * (_PS0 + t * (_PS1 + t * (_PS2 + t * (_PS3 + t * (_PS4 + t * _PS5)))))
-    q = 1.0 + t * (_QS1 + t * (_QS2 + t * (_QS3 + t * _QS4)))
-    return p / q
-
-
-@jit(inline=True)
-def vasin(x):
-    """``arcsin(x)`` for ``|x| <= 1``, branch-free (fdlibm's rational approximation).
-
-    ``|x| < 1/2``: ``x + x R(x^2)``; otherwise ``pi/2 - 2 arcsin(sqrt((1 - |x|)/2))``.
-    Outside [-1, 1] or NaN: NaN.
-    """
-    ax = abs(x)
-    small = x + x * _asin_r(x * x)
-    t = 0.5 * (1.0 - min(ax, 1.0))
-    s = math.sqrt(t)
-    large = _PIO2_HI - (2.0 * (s + s * _asin_r(t)) - _PIO2_LO)
-    res = small if ax < 0.5 else (large if x > 0.0 else -large)
-    return res if ax <= 1.0 else math.nan
-
+# The branch-free exp, log, log1p and asin that the RB08 fast path uses live in
+# roughbrdf._kernels.vmath with the other vectorizable elementary functions (accuracy and
+# method documented there); they are imported above and stay importable from here.
 
 #: largest integer ``n`` (``a = n + 1``) of the vectorizable :func:`gammaincc_int`
 INT_HORNER_MAX = 16

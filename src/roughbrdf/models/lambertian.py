@@ -6,23 +6,29 @@ import math
 
 from numba import prange
 
-from .._kernels import at, driver, jit
+from .._kernels import at, driver, jit, sincos
 from .base import Model, register
 from .parameters import unit_interval
 
 
-@jit
+@jit(inline=True)
 def _lambert_point(ti, tr, phi, gamma, p, flag):
-    if flag:
-        return p[0] / math.pi * max(0.0, math.cos(tr))  # BRIDF = rho cos(theta_r)/pi
+    if flag:  # BRIDF = rho cos(theta_r)/pi; sincos: no libm cos in the driver loop
+        # max: no negative value from a rounded cosine at theta_r = pi/2
+        return p[0] / math.pi * max(0.0, sincos(tr)[1])
     return p[0] / math.pi
 
 
 @driver
 def _lambert_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
-    # module-level loop: cached on disk (roughbrdf._kernels.compile.driver), unlike the generic driver
-    for i in prange(out.size):
-        out[i] = _lambert_point(at(a, i), at(b, i), at(c, i), at(g, i), p, flag)
+    # module-level loop: cached on disk (roughbrdf._kernels.compile.driver); one loop per
+    # quantity with the flag a literal (the BRDF loop is then a plain fill)
+    if flag:
+        for i in prange(out.size):
+            out[i] = _lambert_point(at(a, i), at(b, i), at(c, i), at(g, i), p, 1)
+    else:
+        for i in prange(out.size):
+            out[i] = _lambert_point(at(a, i), at(b, i), at(c, i), at(g, i), p, 0)
 
 
 @register

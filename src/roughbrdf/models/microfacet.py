@@ -21,27 +21,30 @@ from numba import prange
 from .. import distributions as dist
 from .. import shadowing as shd
 from .._kernels import at, driver, jit
-from ..fresnel import check_index, fresnel_polarized
-from ..geometry import half_vector, tr75_eta_from_h
+from ..fresnel import check_index, fresnel_polarized_xy
+from ..geometry import half_vector, tr75_eta_xy
 from .base import Model, register
 from .parameters import Parameter, nonnegative, positive
 
 
-@jit
-def _micro_point(ti, tr, phi, gamma, p, flag):
-    alpha, n, k, ks, dcode, scode, norm, use_f = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
-    dcode = int(dcode)
-    scode = int(scode)
+@jit(inline=True)
+def _micro_eval(ti, tr, phi, gamma, p, flag, dcode, scode):
+    # Inlined and free of libm calls (vexp/vlog/vacos/verfc in D and Lambda, eta as a vector
+    # instead of atan2, selects instead of branches), so that the driver loops vectorize.
+    # With literal dcode/scode/flag (the driver's specialized loops) the branches of the other
+    # distributions, shadowing functions and quantity compile away.
+    alpha, n, k, ks, norm, use_f = p[0], p[1], p[2], p[3], p[6], p[7]
     hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
-    if use_f > 0.0:
-        eta = 0.0 if gamma != gamma else tr75_eta_from_h(si, ci, hx, hy, hz)
-        f = fresnel_polarized(cd, n, k, gamma, eta)
-    else:
-        f = 1.0
+    # F at the local angle; eta (TR75 Eq. 24) from the unnormalized vector sin(s) (cos, sin)
+    ex, ey = tr75_eta_xy(si, ci, hx, hy, hz)
+    fr = fresnel_polarized_xy(cd, n, k, gamma, ex, ey)
+    f = fr if use_f > 0.0 else 1.0
     d = dist.evaluate_d(dcode, hz, alpha, norm)
     if flag:  # BRIDF = f_r cos(theta_r): the 1/cos(theta_r) is never formed
         if scode == shd.NONE:
-            geo = 1.0 / ci if ci > 0.0 else math.inf  # unshadowed: diverges at grazing incidence
+            # unshadowed: diverges at grazing incidence, limit inf (stand-in 1: no 1/0)
+            geo = 1.0 / (ci if ci > 0.0 else 1.0)
+            geo = geo if ci > 0.0 else math.inf
         elif scode == shd.V_GROOVE:
             geo = shd.v_groove_g_over_cos_r(cr, ci, hz, cd)  # G/cos(theta_i) (G symmetric)
         else:
@@ -53,11 +56,41 @@ def _micro_point(ti, tr, phi, gamma, p, flag):
     return 0.25 * t * geo if t > 0.0 else 0.0
 
 
+@jit(inline=True)
+def _micro_point(ti, tr, phi, gamma, p, flag):
+    """The microfacet kernel at one sample, codes read from the packed parameters ``p``."""
+    return _micro_eval(ti, tr, phi, gamma, p, flag, int(p[4]), int(p[5]))
+
+
 @driver
 def _micro_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
-    # module-level loop: cached on disk (roughbrdf._kernels.compile.driver), unlike the generic driver
-    for i in prange(out.size):
-        out[i] = _micro_point(at(a, i), at(b, i), at(c, i), at(g, i), p, flag)
+    # module-level loop: cached on disk (roughbrdf._kernels.compile.driver). Specialized
+    # loops, each with the distribution and the quantity as literals, for GGX and Beckmann
+    # (the shadowing code stays a runtime select: its candidates are cheap); one generic loop
+    # for the other distributions.
+    dcode = int(p[4])
+    scode = int(p[5])
+    if dcode == dist.TR:
+        if flag:
+            for i in prange(out.size):
+                out[i] = _micro_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, 1, dist.TR,
+                                     scode)
+        else:
+            for i in prange(out.size):
+                out[i] = _micro_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, 0, dist.TR,
+                                     scode)
+    elif dcode == dist.BECKMANN:
+        if flag:
+            for i in prange(out.size):
+                out[i] = _micro_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, 1,
+                                     dist.BECKMANN, scode)
+        else:
+            for i in prange(out.size):
+                out[i] = _micro_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, 0,
+                                     dist.BECKMANN, scode)
+    else:
+        for i in prange(out.size):
+            out[i] = _micro_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, flag, dcode, scode)
 
 
 @register
@@ -89,7 +122,7 @@ class Microfacet(Model):
 
     def _check_options(self, options):
         d = dist.get(options["distribution"])
-        s = shd.get(options["shadowing"])
+        s = shd.get(options["shadowing"]).code
         if s in (shd.SMITH_SEPARABLE, shd.SMITH_HEIGHT_CORRELATED) and not d.smith:
             raise ValueError(f"shadowing {options['shadowing']!r} needs a distribution with a "
                              f"Smith Lambda (trowbridge-reitz, beckmann), got {d.name!r}")
@@ -108,5 +141,5 @@ class Microfacet(Model):
         d = dist.get(self._options["distribution"])
         use_f = v["n"] is not None
         return (alpha, v["n"] if use_f else 1.0, (v["k"] or 0.0) if use_f else 0.0,
-                v["ks"], d.code, shd.get(self._options["shadowing"]),
+                v["ks"], d.code, shd.get(self._options["shadowing"]).code,
                 dist.normalization(d.code, alpha), 1.0 if use_f else 0.0)

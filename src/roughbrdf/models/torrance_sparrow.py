@@ -26,20 +26,24 @@ from numpy.typing import ArrayLike
 
 from .. import distributions as dist
 from .._kernels import at, driver, jit
-from ..fresnel import check_index, fresnel_polarized
-from ..geometry import half_vector, tr75_eta_from_h
+from ..fresnel import check_index, fresnel_polarized_xy
+from ..geometry import half_vector, tr75_eta_xy
 from ..shadowing import v_groove_g_over_cos_cos, v_groove_g_over_cos_r
 from .base import Model, register
 from .parameters import Parameter, nonnegative, positive
 
 
-@jit
-def _ts67_point(ti, tr, phi, gamma, p, flag):
-    g, c, n, k, rho_d, use_f = p[0], p[1], p[2], p[3], p[4], p[5]
+@jit(inline=True)
+def _ts67_eval(ti, tr, phi, gamma, p, flag, use_f):
+    # Inlined into the driver and free of libm calls (vacos/vexp in the gaussian, eta as a
+    # vector instead of atan2, selects instead of branches), so that the driver loop
+    # vectorizes; see docs/benchmarks.md. flag/use_f are literals in the driver's loops.
+    g, c, n, k, rho_d = p[0], p[1], p[2], p[3], p[4]
     hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
-    if use_f > 0.0:
-        eta = 0.0 if gamma != gamma else tr75_eta_from_h(si, ci, hx, hy, hz)
-        f = fresnel_polarized(cd, n, k, gamma, eta)
+    if use_f:
+        # F at the local angle; eta (TR75 Eq. 24) from the unnormalized sin(s) (cos, sin)
+        ex, ey = tr75_eta_xy(si, ci, hx, hy, hz)
+        f = fresnel_polarized_xy(cd, n, k, gamma, ex, ey)
     else:
         f = 1.0
     gauss = dist.peak(dist.GAUSS_ANGLE, hz, c)  # exp(-(c alpha_deg)^2), TS67 Eq. 5
@@ -54,11 +58,32 @@ def _ts67_point(ti, tr, phi, gamma, p, flag):
     return rho_d / math.pi * ((t * geo if t > 0.0 else 0.0) + 1.0)
 
 
+@jit(inline=True)
+def _ts67_point(ti, tr, phi, gamma, p, flag):
+    """The TS67 kernel at one sample (``p[5] > 0``: with Fresnel, else F = 1)."""
+    if p[5] > 0.0:
+        return _ts67_eval(ti, tr, phi, gamma, p, flag, True)
+    return _ts67_eval(ti, tr, phi, gamma, p, flag, False)
+
+
 @driver
 def _ts67_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
-    # module-level loop: cached on disk (roughbrdf._kernels.compile.driver), unlike the generic driver
-    for i in prange(out.size):
-        out[i] = _ts67_point(at(a, i), at(b, i), at(c, i), at(g, i), p, flag)
+    # module-level loop: cached on disk (roughbrdf._kernels.compile.driver). One loop per
+    # quantity and Fresnel switch, both literals, so that the unused code is compiled away
+    # (as TR75's quantity flag; F = 1, the paper's Figs. 8, 10, 11, skips the Fresnel part)
+    if p[5] > 0.0:
+        if flag:
+            for i in prange(out.size):
+                out[i] = _ts67_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, 1, True)
+        else:
+            for i in prange(out.size):
+                out[i] = _ts67_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, 0, True)
+    elif flag:
+        for i in prange(out.size):
+            out[i] = _ts67_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, 1, False)
+    else:
+        for i in prange(out.size):
+            out[i] = _ts67_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, 0, False)
 
 
 @register

@@ -105,7 +105,7 @@ class TrowbridgeReitz1975(Model):
     _drive = _tr75_drive
 
     def _check_options(self, options):
-        code = shd.get(options["shadowing"])
+        code = shd.get(options["shadowing"]).code
         if code not in (shd.NONE, shd.V_GROOVE):
             raise ValueError(f"TR75 shadowing must be 'none' or 'v-groove' (report footnote), "
                              f"got {options['shadowing']!r}")

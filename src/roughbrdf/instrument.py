@@ -432,13 +432,14 @@ def aperture_average(model: Model, theta_i: ArrayLike, theta_r: ArrayLike, phi: 
         ap: Aperture | None = aperture
     else:
         ap = Aperture.parse(aperture, points)
-    if quantity not in ("brdf", "bridf"):
+    q = Quantity.parse(quantity)
+    if q is Quantity.RELATIVE:  # the average of a ratio to the specular value is not defined
         raise ValueError(f"quantity must be 'brdf' or 'bridf', got {quantity!r}")
     g = model.prepare(theta_i, theta_r, phi, polarization)
     if ap is None:
-        return model.evaluate_prepared(g, quantity)
+        return model.evaluate_prepared(g, q)
     ti, tr, ph, gam = np.broadcast_arrays(g.theta_i, g.theta_r, g.phi, g.gamma)
     shape = ti.shape
     inst = InstrumentGeometry.build(ti.ravel(), tr.ravel(), ph.ravel(), gam.ravel(), ap)
-    out = inst.evaluate(model, quantity)
+    out = inst.evaluate(model, q)
     return float(out[0]) if shape == () else out.reshape(shape)

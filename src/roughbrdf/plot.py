@@ -40,7 +40,7 @@ from numpy.typing import ArrayLike
 
 from . import geometry
 from .instrument import Aperture, aperture_average
-from .quantity import relative_scale
+from .quantity import Quantity, relative_scale
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -105,26 +105,10 @@ def _as_list(theta: ArrayLike) -> list[float]:
 
 def model_values(model: Model, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
                  quantity: str = "brdf", polarization: Any = None) -> np.ndarray:
-    """The model's ``brdf``, ``bridf``/``brdf_cos`` or ``relative`` value (specular = 1).
-
-    ``relative`` uses the model's own ``relative`` method when it has one (TS67 Eq. 23) and
-    ``brdf / brdf(specular)`` otherwise.
-    """
-    if quantity == "brdf":
-        out = model.brdf(theta_i, theta_r, phi, polarization)
-    elif quantity in ("bridf", "brdf_cos"):
-        out = model.bridf(theta_i, theta_r, phi, polarization)
-    elif quantity == "relative":
-        if hasattr(model, "relative"):
-            out = model.relative(theta_i, theta_r, phi, polarization)
-        else:
-            num = np.asarray(model.brdf(theta_i, theta_r, phi, polarization), dtype=float)
-            den = np.asarray(model.brdf(theta_i, theta_i, 0.0, polarization), dtype=float)
-            out = num / den
-    else:
-        raise ValueError(f"quantity must be 'brdf', 'bridf', 'brdf_cos' or 'relative', "
-                         f"got {quantity!r}")
-    return np.asarray(out, dtype=float)
+    """The model's ``brdf``, ``bridf``/``brdf_cos`` or ``relative`` value (specular = 1):
+    :meth:`roughbrdf.models.Model.evaluate` as a float array."""
+    return np.asarray(model.evaluate(theta_i, theta_r, phi, quantity=Quantity.parse(quantity),
+                                     polarization=polarization), dtype=float)
 
 
 def best_scale(data: ArrayLike, model: ArrayLike) -> float:
@@ -151,8 +135,7 @@ def compared_values(model: Model, theta_i: ArrayLike, theta_r: ArrayLike, phi: A
     cone (:func:`roughbrdf.instrument.aperture_average`; ``brdf`` or ``bridf`` only)."""
     if aperture is None:
         return model_values(model, theta_i, theta_r, phi, quantity, polarization)
-    q = "bridf" if quantity in ("bridf", "brdf_cos") else quantity
-    return np.asarray(aperture_average(model, theta_i, theta_r, phi, aperture, quantity=q,
+    return np.asarray(aperture_average(model, theta_i, theta_r, phi, aperture, quantity=quantity,
                                        polarization=polarization), dtype=float)
 
 
@@ -341,10 +324,10 @@ def _disk_decorations(ax: Axes) -> None:
 # --------------------------------------------------------------------------------------------
 # measurement vs model
 # --------------------------------------------------------------------------------------------
-def _relative_to_cos(meas: Measurement) -> bool:
-    """Relative data proportional to BRDF·cosθr (``meta["relative_to"]`` = bridf/brdf_cos)."""
-    return meas.quantity == "relative" and str(meas.meta.get("relative_to", "brdf")).lower() in (
-        "bridf", "brdf_cos")
+def _curve_quantity(meas: Measurement) -> Quantity:
+    """The model quantity drawn against ``meas``: BRDF, or BRDF·cosθr for cosine-weighted data
+    and relative data proportional to it (``meta["relative_to"]``)."""
+    return Quantity.parse(meas.quantity).compared_with(meas.meta.get("relative_to"))
 
 
 def _comparison_setup(model: Model, measurement: Measurement, channel: int | str,
@@ -361,7 +344,7 @@ def _comparison_setup(model: Model, measurement: Measurement, channel: int | str
     meas = measurement.select_channel(channel)
     data = meas.values[:, 0]
     q = meas.quantity
-    curve_q = "bridf" if q in ("brdf_cos", "bridf") or _relative_to_cos(meas) else "brdf"
+    curve_q = _curve_quantity(meas)
     mod = compared_values(model, meas.theta_i, meas.theta_r, meas.phi, curve_q,
                           meas.polarization, aperture)
     k = relative_scale(data, mod) if q == "relative" else 1.0
@@ -462,15 +445,15 @@ def plot_comparison(model: Model, measurement: Measurement, *, channel: int | st
     """
     fig, ax = new_axes(ax)
     meas, data, mod, q, k = _comparison_setup(model, measurement, channel, aperture)
-    ylabel = QUANTITY_LABELS["bridf" if q in ("bridf", "brdf_cos") else "brdf"]
+    curve_q = _curve_quantity(meas)
+    ylabel = QUANTITY_LABELS[curve_q.value]
     if q == "relative":
-        ylabel = rf"relative value (model {'BRIDF' if _relative_to_cos(meas) else 'BRDF'} / $K$)"
+        ylabel = rf"relative value (model {'BRIDF' if curve_q.cosine_weighted else 'BRDF'} / $K$)"
     inplane = meas.in_plane()
     title = _comparison_title(model, meas, k, aperture)
     if inplane.n_samples == 0:
         _parity(ax, data, mod, ylabel, title)
         return fig, ax
-    curve_q = "bridf" if q in ("bridf", "brdf_cos") or _relative_to_cos(meas) else "brdf"
     _value_axis(ax, _in_plane_slices(ax, model, inplane, k, curve_q, aperture))
     ax.set_xlim(-90, 90)
     ax.set_xticks(np.arange(-90, 91, 30))

@@ -68,6 +68,26 @@ class Quantity(StrEnum):
         """Whether the values have an absolute scale (everything but ``relative``)."""
         return self is not Quantity.RELATIVE
 
+    def compared_with(self, relative_to: object = None) -> Quantity:
+        """The model quantity that data of this quantity are compared with: ``brdf`` or
+        ``bridf`` (= ``brdf_cos``). Relative data are proportional to ``relative_to``
+        (``"brdf"`` when ``None``; ``"brdf_cos"``/``"bridf"`` for TR75's relative BRIDF).
+
+        Examples
+        --------
+        >>> Quantity.BRDF_COS.compared_with()
+        <Quantity.BRIDF: 'bridf'>
+        >>> Quantity.RELATIVE.compared_with("brdf_cos")
+        <Quantity.BRIDF: 'bridf'>
+        """
+        if self is not Quantity.RELATIVE:
+            return Quantity.BRIDF if self.cosine_weighted else Quantity.BRDF
+        rel = Quantity.parse("brdf" if relative_to is None else relative_to, "relative_to")
+        if rel is Quantity.RELATIVE:
+            raise ValueError("relative_to must be 'brdf' or 'bridf' (what the relative values "
+                             f"are proportional to), got {relative_to!r}")
+        return rel.compared_with()
+
 
 def relative_scale(data: ArrayLike, model: ArrayLike, *, weights: ArrayLike | None = None,
                    loss: str = "relative") -> float:

@@ -96,16 +96,15 @@ class Comparison:
         """For ``meas``; ``relative_to`` overrides ``meas.meta["relative_to"]`` (default
         ``"brdf"``) for relative data."""
         q = Quantity.parse(meas.quantity)
-        if q is Quantity.BRDF:
-            return cls(Quantity.BRDF)
-        if q.cosine_weighted:
-            return cls(Quantity.BRIDF)
-        rel = relative_to or meas.meta.get("relative_to") or "brdf"
-        rel = {"brdf_cos": "bridf"}.get(str(rel).lower(), str(rel).lower())
-        if rel not in ("brdf", "bridf"):
+        if q.absolute:
+            return cls(q.compared_with())
+        rel = relative_to or meas.meta.get("relative_to")
+        try:
+            model_q = q.compared_with(rel)
+        except ValueError as exc:  # an unknown name or "relative": say what relative_to means
             raise ValueError(f"relative_to must be 'brdf' or 'bridf' (what the relative values "
-                             f"are proportional to), got {rel!r}")
-        return cls(Quantity(rel), rel)
+                             f"are proportional to), got {rel!r}") from exc
+        return cls(model_q, model_q.value)
 
     @property
     def compared(self) -> str:

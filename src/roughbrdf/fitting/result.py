@@ -292,7 +292,7 @@ class FitResult:
         (BRDF or BRDF cos theta_r), averaged over the fit's aperture (``aperture=False``: at the
         given directions only). On the model's absolute scale; relative data are ``K x``."""
         c = self[channel]
-        q = "bridf" if self.compared in ("bridf", "brdf_cos") else "brdf"
+        q = Quantity.parse(self.compared).compared_with()
         return aperture_average(c.model, theta_i, theta_r, phi,
                                 self.instrument if aperture else None, quantity=q,
                                 polarization=polarization)
@@ -335,9 +335,8 @@ class FitResult:
         """
         c = self[channel]
         meas = self.measurement.subset(c.index).select_channel(c.channel)
-        q = self.compared if self.compared in ("brdf", "bridf") else self.measurement.quantity
         meas = replace(meas, values=(c.scale * c.data)[:, None],
-                       quantity=Quantity.BRIDF if q in ("bridf", "brdf_cos") else Quantity.BRDF,
+                       quantity=Quantity.parse(self.compared).compared_with(),
                        uncertainty=None, meta=dict(meas.meta))
         return c.model, meas
 

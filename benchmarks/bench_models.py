@@ -36,7 +36,7 @@ def tr75_numpy(theta_i, theta_r, phi, e, n, k, rho_L):  # noqa: N803 - paper's s
     """TR75 BRDF (Eqs. 30, 32, 33 divided by cos theta_r), unpolarized, in plain NumPy.
 
     The reference the compiled kernel is compared with: the straightforward vectorized
-    transcription of MODELS.md §3.7-3.8 and §1.4 (complex Fresnel with ``np.sqrt``).
+    transcription of docs/models.md §3.7-3.8 and §1.4 (complex Fresnel with ``np.sqrt``).
     """
     si, ci = np.sin(theta_i), np.cos(theta_i)
     sr, cr = np.sin(theta_r), np.cos(theta_r)

@@ -1,7 +1,7 @@
 """Directional-hemispherical reflectance ``rb.albedo`` (issue: accurate to 1e-4, also for e=0.05).
 
 Oracles: the exact value 1/(1 + e^2) for the microfacet Trowbridge-Reitz model with F = 1 and
-no shadowing at normal incidence (MODELS.md §3.7: the fraction of micro-area with
+no shadowing at normal incidence (docs/models.md §3.7: the fraction of micro-area with
 alpha < 45 deg), Lambert's rho, and independent brute-force quadratures.
 """
 

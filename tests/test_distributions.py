@@ -1,4 +1,4 @@
-"""Facet distributions: normalization ∫ D cos(theta_h) dω = 1 (MODELS.md §3.7), closed forms,
+"""Facet distributions: normalization ∫ D cos(theta_h) dω = 1 (docs/models.md §3.7), closed forms,
 peak-normalized shapes (TR75 Fig. 5), registry with aliases, Smith Lambda.
 
 The normalization integrals are computed here with composite Gauss-Legendre quadrature on
@@ -37,7 +37,7 @@ def norm_of(name, param, width):
 
 @pytest.mark.parametrize("e", [0.05, 0.07, 0.1, 0.2, 0.3, 0.5, 0.68, 1.0, 1.6, 2.0, 3.0])
 def test_trowbridge_reitz_normalized_1e9(e):
-    # MODELS.md §3.7 / §6: ∫ D_std cos(alpha) dΩ = 1 for e = 0.05 ... 3, to 1e-9
+    # docs/models.md §3.7 / §6: ∫ D_std cos(alpha) dΩ = 1 for e = 0.05 ... 3, to 1e-9
     assert norm_of("trowbridge-reitz", e, e) == pytest.approx(1.0, abs=1e-9)
 
 
@@ -84,7 +84,7 @@ def test_unknown_name_suggests(typo, suggestion):
 
 
 def test_ggx_closed_form_and_alpha_equals_e():
-    # D = e^2/(pi (e^2 cos^2 + sin^2)^2) (MODELS.md §3.7), = GGX with alpha = e
+    # D = e^2/(pi (e^2 cos^2 + sin^2)^2) (docs/models.md §3.7), = GGX with alpha = e
     c = np.linspace(0.0, 1.0, 101)
     for e in (0.05, 0.3, 1.0, 2.5):
         expected = e**2 / (np.pi * (e**2 * c**2 + 1 - c**2) ** 2)
@@ -107,7 +107,7 @@ def test_tr_peak_shape_eq31():
 
 @pytest.mark.parametrize("e", [0.1, 0.68, 1.0, 2.0])
 def test_tr_fraction_below_45_deg(e):
-    # MODELS.md §3.7: the fraction of micro-area (projected) with alpha < 45 deg is 1/(1 + e^2)
+    # docs/models.md §3.7: the fraction of micro-area (projected) with alpha < 45 deg is 1/(1 + e^2)
     x, w = np.polynomial.legendre.leggauss(200)
     t = (x + 1) * math.pi / 8
     frac = 2 * math.pi * np.sum(w * math.pi / 8 * D.trowbridge_reitz(np.cos(t), e) * np.cos(t)
@@ -125,7 +125,7 @@ def test_beckmann_closed_form():
 
 
 def test_gaussian_angle_b0():
-    # MODELS.md §2.3: b0 = 2.8316 sr^-1 for c = 0.05/deg (1.5067 for 0.035, 2.4316 for 0.046),
+    # docs/models.md §2.3: b0 = 2.8316 sr^-1 for c = 0.05/deg (1.5067 for 0.035, 2.4316 for 0.046),
     # with theta_h in radians at the API and c per degree
     for c, b0 in [(0.05, 2.8316), (0.035, 1.5067), (0.046, 2.4316)]:
         peak = float(D.gaussian_angle(0.0, c))
@@ -136,7 +136,7 @@ def test_gaussian_angle_b0():
 
 
 def test_berry_and_sirohi_shapes():
-    # TR75 Fig. 5 forms (MODELS.md §3.11): Berry e^2/(e^2 cos^2 + sin^2); Sirohi (p = 2)
+    # TR75 Fig. 5 forms (docs/models.md §3.11): Berry e^2/(e^2 cos^2 + sin^2); Sirohi (p = 2)
     # cos^-2 exp(-A2 tan^2)
     a = np.linspace(0, 1.5, 40)
     c = np.cos(a)
@@ -159,7 +159,7 @@ def test_distributions_positive_and_one_at_normal(c, e):
         assert p >= 0.0 and np.isfinite(p)
         assert D.evaluate(name, 1.0, e, peak_normalized=True) == 1.0
         # oblate ellipsoids (e <= 1) have their maximum at the normal; prolate ones (e > 1,
-        # "vertical grass blades", MODELS.md §3.7) at grazing
+        # "vertical grass blades", docs/models.md §3.7) at grazing
         if name in ("trowbridge-reitz", "berry"):
             assert (p <= 1.0 + 1e-12) if e <= 1 else (p >= 1.0 - 1e-12)
 

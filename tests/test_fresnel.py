@@ -1,4 +1,4 @@
-"""Fresnel reflectance (MODELS.md §1.4, TR75 Eqs. 20-24).
+"""Fresnel reflectance (docs/models.md §1.4, TR75 Eqs. 20-24).
 
 Oracles: TR75's real-arithmetic Eqs. 20-21, written out below independently of the library;
 the normal-incidence formula Eq. 22; Brewster's angle; Snell's law and total internal reflection
@@ -21,14 +21,14 @@ R = rb.fresnel.reflectance
 
 
 def tr75_eq20_21(s: float, n: float, k: float) -> tuple[float, float]:
-    """TR75 Eqs. 20-21 in real arithmetic (MODELS.md §1.4), for local incidence angle s (rad).
+    """TR75 Eqs. 20-21 in real arithmetic (docs/models.md §1.4), for local incidence angle s (rad).
 
     With m2 = n^2 + k^2, a = n sin s/m2, b = k sin s/m2, c = 1 - sin^2 s/m2:
     sinh^2 x = (sqrt(c^2 + 4 b^2) - c)/2, sin s1 = a/cosh x,
     R_perp = [sin^2(s - s1) + sinh^2 x]/[sin^2(s + s1) + sinh^2 x],
     R_par  = R_perp [cos^2(s + s1) + sinh^2 x]/[cos^2(s - s1) + sinh^2 x].
     At s = 0 (0/0) Eq. 22 is used. For n < 1 and k = 0 beyond the critical angle, sin s1 > 1:
-    the refracted wave is evanescent and R = 1 (MODELS.md §1.4 "R -> 1 beyond the critical
+    the refracted wave is evanescent and R = 1 (docs/models.md §1.4 "R -> 1 beyond the critical
     angle").
     """
     if s == 0.0:
@@ -69,7 +69,7 @@ def test_tr75_eqs_20_21_oracle(n, k):
 @settings(max_examples=60, deadline=None)
 @given(s=st.floats(1e-6, math.radians(89.99)), n=st.floats(0.05, 10.0), k=st.floats(0.0, 10.0))
 def test_tr75_oracle_property(s, n, k):
-    # (the oracle is 0/0 as s -> 0, where MODELS.md §1.4 says to use Eq. 22, tested below)
+    # (the oracle is 0/0 as s -> 0, where docs/models.md §1.4 says to use Eq. 22, tested below)
     rs, rp = tr75_eq20_21(s, n, k)
     assert R(math.cos(s), n, k, "s") == pytest.approx(rs, rel=1e-8, abs=1e-12)
     assert R(math.cos(s), n, k, "p") == pytest.approx(rp, rel=1e-8, abs=1e-12)
@@ -145,7 +145,7 @@ def test_snell_dielectric(n):
 
 
 def test_conjugate_index_convention():
-    # MODELS.md §1.4: n + ik and n - ik give identical reflectances; with the library's k >= 0
+    # docs/models.md §1.4: n + ik and n - ik give identical reflectances; with the library's k >= 0
     # this is a check against NumPy complex arithmetic with the conjugate index n - ik
     c = np.linspace(0, 1, 101)
     for n, k in INDICES:

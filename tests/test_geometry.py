@@ -1,8 +1,8 @@
-"""Geometry: the common frame (MODELS.md §1.1), conversions to each paper's angles (§1.3) as
+"""Geometry: the common frame (docs/models.md §1.1), conversions to each paper's angles (§1.3) as
 round trips, and the derived angles (theta_h, theta_d, phi_h, TS67 psi_p/theta_p, TR75 eta).
 
 Oracles: the unit vectors of §1.1 and §3.1 written out with NumPy, the identities quoted in
-MODELS.md, and the printed TS67 Eq. 14 / TR75 Eqs. 16-17 where they are valid.
+docs/models.md, and the printed TS67 Eq. 14 / TR75 Eqs. 16-17 where they are valid.
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ def same_direction(t1, p1, t2, p2, atol=1e-9):
 @settings(max_examples=100, deadline=None)
 @given(ti=ZEN, tr=ZEN, ph=AZ)
 def test_round_trip_ts67(ti, tr, ph):
-    # TS67's (psi, theta, phi) is the common frame (MODELS.md §1.3)
+    # TS67's (psi, theta, phi) is the common frame (docs/models.md §1.3)
     psi, theta, phi = G.to_ts67(ti, tr, ph)
     assert (psi, theta, phi) == (ti, tr, ph)
     assert tuple(map(float, G.from_ts67(psi, theta, phi))) == (ti, tr, ph)
@@ -75,7 +75,7 @@ def test_tr75_vectors(beta, elev, psi):
 @given(ti=ZEN, tr=ZEN, ph=AZ)
 def test_round_trip_rb08(ti, tr, ph):
     # RB08 direction cosines alpha = sin(theta_s) cos(phi), beta = sin(theta_s) sin(phi),
-    # alpha0 = sin(theta_i) (MODELS.md §1.3/§4.3); specular point (alpha0, 0)
+    # alpha0 = sin(theta_i) (docs/models.md §1.3/§4.3); specular point (alpha0, 0)
     a, b, a0 = G.to_rb08(ti, tr, ph)
     assert a0 == pytest.approx(math.sin(ti), abs=1e-15)
     assert math.hypot(a, b) == pytest.approx(math.sin(tr), abs=1e-15)
@@ -157,7 +157,7 @@ def test_half_and_difference_angles_match_vectors():
     h = s / np.linalg.norm(s, axis=-1, keepdims=True)
     np.testing.assert_allclose(np.cos(G.theta_h(ti, tr, ph)), h[..., 2], atol=1e-12)
     np.testing.assert_allclose(np.cos(G.theta_d(ti, tr, ph)), np.sum(wi * h, -1), atol=1e-12)
-    # MODELS.md §1.1: cos 2 theta_d = w_i.w_r and cos th = (cos ti + cos tr)/(2 cos td)
+    # docs/models.md §1.1: cos 2 theta_d = w_i.w_r and cos th = (cos ti + cos tr)/(2 cos td)
     td = G.theta_d(ti, tr, ph)
     np.testing.assert_allclose(np.cos(2 * td), np.cos(ti) * np.cos(tr)
                                - np.sin(ti) * np.sin(tr) * np.cos(ph), atol=1e-12)
@@ -182,7 +182,7 @@ def test_specular_and_retro():
 @settings(max_examples=200, deadline=None)
 @given(ti=ZEN, tr=ZEN, ph=AZ)
 def test_ts67_projected_angles(ti, tr, ph):
-    # MODELS.md §2.4: psi_p >= 0, theta_p = psi_p + 2 alpha_s, |alpha_s| = theta_h, and the
+    # docs/models.md §2.4: psi_p >= 0, theta_p = psi_p + 2 alpha_s, |alpha_s| = theta_h, and the
     # projections of w_i and w_r on the plane (z, u) are mirror images about h
     from roughbrdf.geometry import ts67_projected
 
@@ -196,7 +196,7 @@ def test_ts67_projected_angles(ti, tr, ph):
 
 
 def test_ts67_projected_in_plane_eq15():
-    # MODELS.md §2.4 Eq. 15: in the plane of incidence psi_p = psi, theta_p = theta (signed)
+    # docs/models.md §2.4 Eq. 15: in the plane of incidence psi_p = psi, theta_p = theta (signed)
     psi = np.radians(np.array([10.0, 30, 45, 60, 75]))
     for th in np.radians([-80.0, -30, 0, 20, 60, 85]):
         tr, ph = G.from_signed_angle(th)
@@ -205,7 +205,7 @@ def test_ts67_projected_in_plane_eq15():
 
 
 def test_ts67_printed_eq14_where_valid():
-    # MODELS.md §2.4: the printed Eq. 14 (with |psi_p|) agrees with the vector recipe wherever
+    # docs/models.md §2.4: the printed Eq. 14 (with |psi_p|) agrees with the vector recipe wherever
     # its arcsin branches are valid (beta1 acute: the receiver not beyond the source)
     ti, tr, ph = random_geometry(5000, 3)
     ti, tr, ph = ti[ti > 0.05], tr[ti > 0.05], ph[ti > 0.05]
@@ -223,7 +223,7 @@ def test_ts67_printed_eq14_where_valid():
 
 def test_tr75_eta_and_eqs_16_17():
     # TR75 Eq. 16 (azimuth z of the micro-normal from the source side), Eq. 17 (cos s) and
-    # Eq. 23 (cos eta), in TR75's own angles converted with from_tr75 (MODELS.md §3.1, §3.5)
+    # Eq. 23 (cos eta), in TR75's own angles converted with from_tr75 (docs/models.md §3.1, §3.5)
     rng = np.random.default_rng(4)
     beta = rng.uniform(0.01, 1.5, 3000)
     elev = rng.uniform(0.01, 1.5, 3000)
@@ -234,7 +234,7 @@ def test_tr75_eta_and_eqs_16_17():
     z = np.arctan2(np.sin(psi) * np.cos(elev), np.sin(beta) + np.cos(psi) * np.cos(elev))
     cos_s = np.cos(z) * np.sin(alpha) * np.sin(beta) + np.cos(alpha) * np.cos(beta)  # Eq. 17
     np.testing.assert_allclose(np.cos(s), cos_s, atol=1e-10)
-    # phi_h = pi - z (MODELS.md §1.3)
+    # phi_h = pi - z (docs/models.md §1.3)
     ok = np.sin(alpha) > 1e-6
     np.testing.assert_allclose(wrap(G.phi_h(ti, tr, ph)[ok] - (np.pi - z[ok])), 0, atol=1e-8)
     eta = G.tr75_eta(ti, tr, ph)

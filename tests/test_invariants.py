@@ -1,8 +1,8 @@
 """Invariants checked on every registered model (and on variants of their options).
 
 Physics identities (no reference numbers needed): non-negativity, the phi -> -phi symmetry of
-isotropic surfaces (MODELS.md §1.3), Helmholtz reciprocity for models whose ``reciprocal`` is
-True, ``bridf = brdf cos(theta_r)`` (MODELS.md §1.2), broadcasting of n-dimensional inputs, no
+isotropic surfaces (docs/models.md §1.3), Helmholtz reciprocity for models whose ``reciprocal`` is
+True, ``bridf = brdf cos(theta_r)`` (docs/models.md §1.2), broadcasting of n-dimensional inputs, no
 NaN anywhere on the closed hemisphere (including exactly normal, grazing, specular and retro
 geometries), and ValueError naming the parameter and the value for invalid inputs.
 """
@@ -99,7 +99,7 @@ def test_non_negative_and_no_nan(model, geo):
 @settings(max_examples=5, deadline=None)
 @given(geo=geometry_batch())
 def test_phi_symmetry(model, geo):
-    # isotropic surfaces: phi -> -phi never changes a value (MODELS.md §1.3)
+    # isotropic surfaces: phi -> -phi never changes a value (docs/models.md §1.3)
     ti, tr, ph = geo
     ti = _clip_ti(model, ti)
     np.testing.assert_allclose(model.brdf(ti, tr, -ph), model.brdf(ti, tr, ph), rtol=1e-11)
@@ -188,7 +188,7 @@ def test_no_nan_special_geometries(model):
     assert (brdf >= 0).all() and (bridf >= 0).all()
     # The BRIDF stays finite (for TR75 too, whose BRDF is inf at the horizon). The only
     # exception: models without shadowing diverge as 1/cos(theta_i) at grazing incidence
-    # (MODELS.md §3.13), and return that limit, inf, where cos(theta_i) rounds to 0.
+    # (docs/models.md §3.13), and return that limit, inf, where cos(theta_i) rounds to 0.
     unshadowed = (model.name in ("trowbridge-reitz-1975", "microfacet")
                   and model.options.get("shadowing") == "none")
     grazing_i = np.cos(ti) < 1e-15

@@ -1,6 +1,7 @@
-"""Reproduction targets of TS67 and TR75 (MODELS.md §2.7, §3.10-3.12, §5), computed by the library.
+"""Reproduction targets of TS67 and TR75 (docs/models.md §2.7, §3.10-3.12, §5), computed by the
+library.
 
-Every expected number below comes from MODELS.md (the section is named at each table), which
+Every expected number below comes from docs/models.md (the section is named at each table), which
 quotes an independent NumPy/SciPy implementation of the specification, or from an identity
 stated next to it.
 """
@@ -25,12 +26,12 @@ def ts_fig8():
 
 
 def cement(**kw):
-    """TR75 Table 1, cement column (MODELS.md §3.10)."""
+    """TR75 Table 1, cement column (docs/models.md §3.10)."""
     return rb.model("trowbridge-reitz-1975", e=0.68, n=1.0, k=0.9, rho_L=0.33, **kw)
 
 
 # ------------------------------------------------------------------------------------------
-# TS67 Fig. 7: G/cos(theta) in the plane of incidence (MODELS.md §2.7 table)
+# TS67 Fig. 7: G/cos(theta) in the plane of incidence (docs/models.md §2.7 table)
 # ------------------------------------------------------------------------------------------
 FIG7_THETA = [-89.9, -80, -60, -45, -30, 0, 30, 45, 60, 75, 80, 85, 89.9]
 FIG7 = {  # psi -> G/cos(theta) at FIG7_THETA (negative theta = phi 180 deg)
@@ -52,7 +53,7 @@ def test_ts67_fig7_g_over_cos_table(psi):
 
 @pytest.mark.parametrize("psi, limit", [(30, 3.4641), (60, 7.4641), (75, 15.1915)])
 def test_ts67_fig7_grazing_forward_limit(psi, limit):
-    # MODELS.md §2.7: grazing forward limit 2 cot((90 deg - psi)/2), exactly at theta = 90 deg
+    # docs/models.md §2.7: grazing forward limit 2 cot((90 deg - psi)/2), exactly at theta = 90 deg
     assert rb.shadowing.g_over_cos_r(deg(psi), math.pi / 2, 0.0) == pytest.approx(limit, abs=1e-4)
     assert limit == pytest.approx(2 / math.tan(deg(90 - psi) / 2), abs=1e-4)
 
@@ -60,7 +61,7 @@ def test_ts67_fig7_grazing_forward_limit(psi, limit):
 @pytest.mark.parametrize("psi, phi, limit", [(75, 0, 15.1915), (75, 45, 1.6330),
                                              (60, 120, 0.6978)])
 def test_ts67_eq22_grazing_limit_out_of_plane(psi, phi, limit):
-    # MODELS.md §2.5: lim_{theta -> 90 deg} G/cos(theta) = 2 cos(theta_h)/cos(theta_d), checked
+    # docs/models.md §2.5: lim_{theta -> 90 deg} G/cos(theta) = 2 cos(theta_h)/cos(theta_d), checked
     # for these (psi, phi) pairs; the per-branch evaluation reaches it without 0/0 ...
     at_90 = rb.shadowing.g_over_cos_r(deg(psi), math.pi / 2, deg(phi))
     assert at_90 == pytest.approx(limit, abs=1e-4)
@@ -71,7 +72,7 @@ def test_ts67_eq22_grazing_limit_out_of_plane(psi, phi, limit):
 
 @pytest.mark.parametrize("psi", [10, 20, 30, 40, 45])
 def test_ts67_fig7_back_peak_small_psi(psi):
-    # MODELS.md §2.7: backward local maximum at theta = (psi - 180)/3 with value
+    # docs/models.md §2.7: backward local maximum at theta = (psi - 180)/3 with value
     # 1/cos((180 - psi)/3) for psi <= 45 deg (e.g. psi = 30 -> -50 deg, 1.5557)
     theta = np.linspace(-89.9, 0, 8991)
     tr, ph = rb.geometry.from_signed_angle(deg(theta))
@@ -83,12 +84,13 @@ def test_ts67_fig7_back_peak_small_psi(psi):
     assert peak == pytest.approx(1 / math.cos(deg((180 - psi) / 3)), abs=1e-9)
     assert peak >= g.max() - 1e-12
     if psi == 30:
-        assert peak == pytest.approx(1.5557, abs=1e-4)  # the example quoted in MODELS.md
+        assert peak == pytest.approx(1.5557, abs=1e-4)  # the example quoted in docs/models.md
 
 
 @pytest.mark.parametrize("psi", [45, 60, 75])
 def test_ts67_fig7_back_peak_at_retro_large_psi(psi):
-    # MODELS.md §2.7: for psi >= 45 deg the back maximum is at the retro direction, value 2 cos psi
+    # docs/models.md §2.7: for psi >= 45 deg the back maximum is at the retro direction,
+    # value 2 cos psi
     theta = np.linspace(-89.9, 0, 8991)
     tr, ph = rb.geometry.from_signed_angle(deg(theta))
     g = rb.shadowing.g_over_cos_r(deg(psi), tr, ph)
@@ -98,7 +100,7 @@ def test_ts67_fig7_back_peak_at_retro_large_psi(psi):
 
 
 # ------------------------------------------------------------------------------------------
-# TS67 Fig. 8: Eq. 23 with F = 1, g = 2/3, c = 0.05/deg (MODELS.md §2.7 table and fine rows)
+# TS67 Fig. 8: Eq. 23 with F = 1, g = 2/3, c = 0.05/deg (docs/models.md §2.7 table and fine rows)
 # ------------------------------------------------------------------------------------------
 FIG8 = {  # psi: (theta of forward max, ratio at max, at theta 0, at 89.99, at -60)
     10: (13.3, 1.002, 0.970, 0.610, 0.627),
@@ -123,14 +125,14 @@ def test_ts67_fig8_peaks_and_ratios(ts_fig8, psi):
 
 
 def test_ts67_fig8_peaks_grow_with_psi(ts_fig8):
-    # MODELS.md §2.7, qualitative target stated by the paper: peaks grow with psi
+    # docs/models.md §2.7, qualitative target stated by the paper: peaks grow with psi
     theta = deg(np.linspace(0, 89.99, 9000))
     peaks = [np.max(ts_fig8.relative(deg(p), theta, 0.0)) for p in (10, 30, 45, 60, 75)]
     assert np.all(np.diff(peaks) > 0)
 
 
 def test_ts67_fig8_psi75_peak_at_89_deg(ts_fig8):
-    # MODELS.md §2.7: "3.19 (3.06 at 89 deg)"
+    # docs/models.md §2.7: "3.19 (3.06 at 89 deg)"
     assert ts_fig8.relative(deg(75), deg(89), 0.0) == pytest.approx(3.06, abs=5e-3)
 
 
@@ -145,7 +147,7 @@ def test_ts67_fig8_fine_rows(ts_fig8, psi, thetas, expected):
 
 
 def test_ts67_relative_is_one_at_specular(ts_fig8):
-    # Eq. 23 is normalized by the specular value (MODELS.md §2.3), for any psi and F
+    # Eq. 23 is normalized by the specular value (docs/models.md §2.3), for any psi and F
     psi = deg(np.array([0.0, 10, 45, 80, 89]))
     assert np.allclose(ts_fig8.relative(psi, psi, 0.0), 1.0, rtol=1e-14)
     al = rb.model("ts67", g=2 / 3, c=0.05, n=0.77, k=6.08, rho_d=0.3)
@@ -153,7 +155,7 @@ def test_ts67_relative_is_one_at_specular(ts_fig8):
 
 
 # ------------------------------------------------------------------------------------------
-# TS67 Figs. 10/11: out of the plane, psi = 75, theta = 80 (MODELS.md §2.7)
+# TS67 Figs. 10/11: out of the plane, psi = 75, theta = 80 (docs/models.md §2.7)
 # ------------------------------------------------------------------------------------------
 FIG10_PHI = [0, 30, 60, 90, 120, 150, 180]
 
@@ -171,7 +173,7 @@ def test_ts67_fig10_ratio_confined_to_plane(ts_fig8):
 
 
 def test_ts67_absolute_matches_eq12_form():
-    # brdf() is (rho_d/pi)[g F G exp(-c^2 a^2)/(cos i cos r) + 1] (MODELS.md §2.3), written out
+    # brdf() is (rho_d/pi)[g F G exp(-c^2 a^2)/(cos i cos r) + 1] (docs/models.md §2.3), written out
     # here with the library's independent parts (V-groove G and the complex Fresnel)
     g, c, n, k, rho = 2.0, 0.05, 1.74, 0.3, 0.4
     ts = rb.model("ts67", g=g, c=c, n=n, k=k, rho_d=rho)
@@ -200,7 +202,7 @@ def test_ts67_finite_at_horizon_and_matches_limit(ts_fig8):
 
 
 # ------------------------------------------------------------------------------------------
-# TR75 Table 1 (MODELS.md §3.10): directional-hemispherical reflectance at normal incidence
+# TR75 Table 1 (docs/models.md §3.10): directional-hemispherical reflectance at normal incidence
 # ------------------------------------------------------------------------------------------
 TABLE1 = {  # column: (e, n, k, rho_L, total DHR at beta = 0)
     "black velvet, set 1": (0.89, 1.60, 0.00, 0.020, 0.051),
@@ -220,7 +222,7 @@ def test_tr75_table1_dhr_normal_incidence(surface):
 
 
 def test_tr75_table1_interface_parts():
-    # MODELS.md §3.10 "interface part" column: the same DHR with rho_L = 0
+    # docs/models.md §3.10 "interface part" column: the same DHR with rho_L = 0
     for surface, part in [("black velvet, set 1", 0.031), ("cement", 0.120),
                           ("plywood", 0.399), ("grass", 0.112)]:
         e, n, k, _, _ = TABLE1[surface]
@@ -229,7 +231,7 @@ def test_tr75_table1_interface_parts():
 
 
 def test_tr75_dhr_rises_with_beta():
-    # MODELS.md §3.10: no shadowing, so the DHR rises with beta; cement 0.450, 0.464, 0.548,
+    # docs/models.md §3.10: no shadowing, so the DHR rises with beta; cement 0.450, 0.464, 0.548,
     # 0.919 and Black Velvet 0.051, 0.057, 0.093, 0.275 at beta = 0, 30, 60, 80 deg
     beta = deg(np.array([0.0, 30, 60, 80]))
     np.testing.assert_allclose(rb.albedo(cement(), beta), [0.450, 0.464, 0.548, 0.919],
@@ -249,7 +251,7 @@ def test_tr75_dhr_rises_with_beta():
     (75, [0.1261, 0.1305, 0.1380]),
 ])
 def test_tr75_cement_sample_values(elev, expected):
-    # MODELS.md §3.12: cement, unpolarized, beta = 45 deg, TR75 azimuth psi = 0/90/180 deg,
+    # docs/models.md §3.12: cement, unpolarized, beta = 45 deg, TR75 azimuth psi = 0/90/180 deg,
     # converted to the common frame by geometry.from_tr75
     ti, tr, phi = rb.geometry.from_tr75(deg(45), deg(elev), deg(np.array([0.0, 90, 180])))
     np.testing.assert_allclose(cement().bridf(ti, tr, phi), expected, atol=5e-5)
@@ -261,7 +263,7 @@ def test_tr75_cement_sample_value_zenith():
 
 
 def test_tr75_normal_incidence_closed_form():
-    # MODELS.md §3.12: f_rI(0; 90 deg, 0) = R(0)/(4 pi e^2), 0.02649 for e = 0.4, n = 1.6
+    # docs/models.md §3.12: f_rI(0; 90 deg, 0) = R(0)/(4 pi e^2), 0.02649 for e = 0.4, n = 1.6
     m = rb.model("tr75", e=0.4, n=1.6, k=0.0, rho_L=0.0)
     assert m.bridf(0.0, 0.0, 0.0) == pytest.approx(0.02649, abs=5e-6)
     r0 = ((1.6 - 1) / (1.6 + 1)) ** 2
@@ -283,7 +285,7 @@ def test_tr75_brdf_is_bridf_over_cos_and_inf_at_horizon():
 
 
 def test_tr75_polarization_eq24():
-    # MODELS.md §3.5: the mean of gamma = 0 and gamma = 90 deg is the unpolarized value; "p" is
+    # docs/models.md §3.5: the mean of gamma = 0 and gamma = 90 deg is the unpolarized value; "p" is
     # gamma = 0 and "s" gamma = 90 deg
     m = cement()
     rng = np.random.default_rng(3)
@@ -319,7 +321,7 @@ def test_tr75_per_sample_polarization_array():
 
 
 # ------------------------------------------------------------------------------------------
-# TR75 Fig. 5 (MODELS.md §3.11): half widths at half maximum of the peak-normalized forms
+# TR75 Fig. 5 (docs/models.md §3.11): half widths at half maximum of the peak-normalized forms
 # ------------------------------------------------------------------------------------------
 def _hwhm_deg(name, param):
     def half(a):
@@ -340,7 +342,7 @@ def test_tr75_fig5_hwhm(name, param, hwhm):
 
 
 def test_tr75_fig5_sirohi_p4_is_beckmann():
-    # MODELS.md §3.11: the p = 4 Sirohi form cos^-4 exp(-A^2 tan^2) with A^2 = 6.93 has HWHM
+    # docs/models.md §3.11: the p = 4 Sirohi form cos^-4 exp(-A^2 tan^2) with A^2 = 6.93 has HWHM
     # 20.32 deg; it is Beckmann with m = 1/A (distributions module docstring)
     assert _hwhm_deg("beckmann", 1 / math.sqrt(6.93)) == pytest.approx(20.32, abs=0.05)
 
@@ -361,7 +363,7 @@ def _random_geometry(n, seed, max_deg=89.0):
 
 
 def test_relation1_ts67_g_is_v_cavity_g():
-    # MODELS.md §5.1: TS67 G (Table I in projected angles) == V-cavity
+    # docs/models.md §5.1: TS67 G (Table I in projected angles) == V-cavity
     # min(1, 2 cos th cos tr / cos td, 2 cos th cos ti / cos td), here written with NumPy
     ti, tr, ph = _random_geometry(20000, 4, 90.0)
     th = rb.geometry.theta_h(ti, tr, ph)
@@ -373,8 +375,8 @@ def test_relation1_ts67_g_is_v_cavity_g():
 
 
 def test_relation2_tr75_is_ggx_microfacet_times_cos():
-    # MODELS.md §5.2: TR75 Eq. 30 == (microfacet BRDF, GGX D with alpha = e, Fresnel at theta_d,
-    # no G) x cos(theta_r)
+    # docs/models.md §5.2: TR75 Eq. 30 == (microfacet BRDF, GGX D with alpha = e, Fresnel at
+    # theta_d, no G) x cos(theta_r)
     ti, tr, ph = _random_geometry(5000, 5)
     for e, n, k in [(0.68, 1.0, 0.9), (0.24, 1.0, 0.4), (1.6, 0.7, 1.3), (0.05, 1.5, 0.0)]:
         tr75 = rb.model("tr75", e=e, n=n, k=k, rho_L=0.0)
@@ -393,7 +395,7 @@ def test_relation2_with_lambertian_sum():
 
 
 def test_relation3_ts_style_ratio():
-    # MODELS.md §5.3 (TR75 footnote): with D set to 1 and no G, Eq. 30 converted to a TS-style
+    # docs/models.md §5.3 (TR75 footnote): with D set to 1 and no G, Eq. 30 converted to a TS-style
     # ratio of BRRDFs equals TS67's specular term. Both are F D/(4 cos i cos r) forms: TR75 with
     # the peak shape divided out (D -> 1), and TS67 with g -> infinity (no diffuse part), c -> 0
     # (Gaussian -> 1) and G removed, relative to the specular direction.
@@ -417,7 +419,7 @@ def test_relation3_ts_style_ratio():
 
 
 def test_relation4_rense_equals_ts67_gaussian():
-    # MODELS.md §5.4: exp(-c^2 alpha^2) with c = 0.046/deg is Rense's exp(-0.0021 alpha_deg^2)
+    # docs/models.md §5.4: exp(-c^2 alpha^2) with c = 0.046/deg is Rense's exp(-0.0021 alpha_deg^2)
     a = deg(np.linspace(0, 60, 61))
     rense = np.exp(-0.0021 * np.degrees(a) ** 2)
     ts = rb.distributions.evaluate("gaussian-angle", np.cos(a), math.sqrt(0.0021),

@@ -1,8 +1,8 @@
-"""Renhorn & Boreman (2008), RB08: the MODELS.md §4.14 targets and the model's contract.
+"""Renhorn & Boreman (2008), RB08: the docs/models.md §4.14 targets and the model's contract.
 
-The reference numbers come from MODELS.md §4 (computed there by an independent NumPy/SciPy
+The reference numbers come from docs/models.md §4 (computed there by an independent NumPy/SciPy
 implementation). ``ref_terms`` below is a second, plain NumPy/SciPy transcription of the
-MODELS.md §4/§8 formulas as printed (literal N of Eq. 6, literal Eq. 13 with Sgn, Eqs. 16-17 in
+docs/models.md §4/§8 formulas as printed (literal N of Eq. 6, literal Eq. 13 with Sgn, Eqs. 16-17 in
 complex arithmetic, ``scipy.special.gammaincc``); the compiled kernel is checked against it.
 """
 
@@ -39,7 +39,7 @@ def random_geometry(n, seed=0, ti_max=1.55):
 
 
 # ------------------------------------------------------------------------------------------
-# independent NumPy/SciPy reference (MODELS.md §4, §8)
+# independent NumPy/SciPy reference (docs/models.md §4, §8)
 # ------------------------------------------------------------------------------------------
 def fresnel_eq16_17(alpha, n_eff, k_eff):
     """RB08 Eqs. 16-17 written literally (complex arithmetic): (R_s, R_p) at sine alpha."""
@@ -53,13 +53,13 @@ def fresnel_eq16_17(alpha, n_eff, k_eff):
 
 
 def n_literal(a0, rho):
-    """Eq. 6 as printed (MODELS.md §4.5)."""
+    """Eq. 6 as printed (docs/models.md §4.5)."""
     return 1.0 / (math.pi * np.log((1 - a0**2 + rho**2 + np.sqrt(
         rho**4 + 2 * a0**2 * rho**2 + 2 * rho**2 + (1 - a0**2) ** 2)) / (2 * rho**2)))
 
 
 def vm_literal(zeta, zeta0, alpha, w_a, w_b, gamma, delta):
-    """Eq. 13 as printed, with Sgn, recommended signs (MODELS.md §4.8)."""
+    """Eq. 13 as printed, with Sgn, recommended signs (docs/models.md §4.8)."""
     e0 = np.exp(-gamma * zeta0 * np.exp(-delta * zeta0**2))
     b = np.exp(-w_a * zeta * np.exp(-w_b * alpha**2))
     sg = np.sign(zeta)
@@ -68,7 +68,7 @@ def vm_literal(zeta, zeta0, alpha, w_a, w_b, gamma, delta):
 
 def ref_terms(ti, ts, phi, p, zeta="angle", weight="geometric-mean", norm="literal",
               pol="unpolarized", retro_shadowing="width"):
-    """(surface, bulk, retro, parts) of RB08 by MODELS.md §8 (``parts``: sigma_s, D, N, Vm...).
+    """(surface, bulk, retro, parts) of RB08 by docs/models.md §8 (``parts``: sigma_s, D, N, Vm...).
 
     ``retro_shadowing="amplitude"``: the retro V pair multiplies the retro strength instead of
     its width term (the model's option of that name).
@@ -133,7 +133,7 @@ def test_eq6_normalizes_basic_lobe(a0, rho):
     n = rbm.rb08_norm(1 - a0 * a0, a0 * a0, rho)
     assert n * disk == pytest.approx(1.0, abs=1e-8)
     assert n == pytest.approx(n_literal(a0, rho), rel=1e-13)  # stable form = printed form
-    if a0 == 0.0:  # MODELS.md §4.5: 1/(pi ln((1 + rho^2)/rho^2))
+    if a0 == 0.0:  # docs/models.md §4.5: 1/(pi ln((1 + rho^2)/rho^2))
         assert n == pytest.approx(1 / (math.pi * math.log((1 + rho**2) / rho**2)), rel=1e-14)
 
 
@@ -167,7 +167,7 @@ def test_v_identities():
 
 
 def test_v_step_limit_for_large_n():
-    # MODELS.md §4.7, computed: n = 500, w = 0.8 gives 1, 1, 1, 1, 0.494, 0.000
+    # docs/models.md §4.7, computed: n = 500, w = 0.8 gives 1, 1, 1, 1, 0.494, 0.000
     got = rb.shadowing.V([0, 0.2, 0.4, 0.6, 0.8, 1.0], 0.8, 500)
     np.testing.assert_allclose(got, [1, 1, 1, 1, 0.494, 0.000], atol=5e-4)
     # V(w) -> 1/2: the median of a gamma variable is a - 1/3 + ..., so
@@ -259,7 +259,7 @@ def test_vm_piecewise_identities_and_continuity():
         got = rb.shadowing.Vm(z, zeta0, w_a, w_b, gamma, delta)
         e0 = math.exp(-gamma * zeta0 * math.exp(-delta * zeta0**2))
         b = np.exp(-w_a * z * np.exp(-w_b * al**2))
-        expect = np.where(z < 0, b, 1 - e0 * (1 - b))  # MODELS.md §4.8 piecewise form
+        expect = np.where(z < 0, b, 1 - e0 * (1 - b))  # docs/models.md §4.8 piecewise form
         np.testing.assert_allclose(got, expect, rtol=1e-14)
         np.testing.assert_allclose(got, vm_literal(z, zeta0, al, w_a, w_b, gamma, delta),
                                    rtol=1e-14)  # = Eq. 13 as printed
@@ -387,7 +387,7 @@ def test_energy_split_identity(weight, pol):
 # ------------------------------------------------------------------------------------------
 def unit_sigma(rho, normalization):
     # sigma_surface = 1: a perfect conductor (R = 1 - 4e-16 at every angle), no bulk or retro
-    # term, Vm = 1 (w_a = 0); w = 0.9, n = 4 as in MODELS.md §4.12
+    # term, Vm = 1 (w_a = 0); w = 0.9, n = 4 as in docs/models.md §4.12
     return rb.model("rb08", rho=rho, w=0.9, n=4, w_a=0.0, n_eff=1.0, k_eff=1e8, bulk=0.0,
                     retro=0.0, normalization=normalization)
 
@@ -479,7 +479,7 @@ def test_hypothesis_non_negative_and_phi_symmetric(params, opts, seed, integer_n
 
 
 # ------------------------------------------------------------------------------------------
-# retro_shadowing: where the speculative retro pair (w_r, n_r) acts (MODELS.md §4.10-4.11)
+# retro_shadowing: where the speculative retro pair (w_r, n_r) acts (docs/models.md §4.10-4.11)
 # ------------------------------------------------------------------------------------------
 def test_retro_shadowing_option_default_unchanged_and_validated():
     m = rb.model("rb08", **FULL)

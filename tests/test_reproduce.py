@@ -1,8 +1,8 @@
-"""The numbers behind the reproduced figures against MODELS.md targets, and the written files.
+"""The numbers behind the reproduced figures against docs/models.md targets, and the written files.
 
-Targets and their sources (all in ../shared/spec/MODELS.md):
+Targets and their sources (all in docs/models.md):
 * TS67 Fig. 7 table, back peaks, Fig. 8 peaks and finer rows, Figs. 10/11 phi row: §2.7;
-* TS67 Fig. 9 with MODELS' placeholder indices (MgO 1.74, Al 0.77 + 6.08i): §2.7;
+* TS67 Fig. 9 with the specification's placeholder indices (MgO 1.74, Al 0.77 + 6.08i): §2.7;
 * TR75 Fig. 5 HWHMs: §3.11; Table 1 DHRs: §3.10; cement sample BRIDFs: §3.12.
 Tolerances follow the core issue: Fig. 7 rows 1e-3, DHRs ±0.002, HWHMs 0.05°.
 """
@@ -359,7 +359,7 @@ def test_rb08_fig2_vm_identities(rbr):
 def test_rb08_fig3_two_orders_of_magnitude(rbr):
     rng = rbr["rb08_fig03"].tables["range"]
     overall = rng.rows[-1]
-    assert overall[0] == "all" and overall[-1] >= 100.0              # MODELS.md §4.14
+    assert overall[0] == "all" and overall[-1] >= 100.0              # docs/models.md §4.14
     curves = rbr["rb08_fig03"].tables["curves"]
     for c in curves.columns[1:]:
         y = curves.column(c)

@@ -1,4 +1,4 @@
-"""Shadowing/masking: TS67 V-groove (Table I vs closed form, MODELS.md §2.5), per-branch
+"""Shadowing/masking: TS67 V-groove (Table I vs closed form, docs/models.md §2.5), per-branch
 G/cos, Smith separable and height-correlated, the registry of names.
 """
 
@@ -26,7 +26,7 @@ def random_geometry(n, seed):
 
 
 def test_table_i_equals_closed_form_random_out_of_plane():
-    # MODELS.md §2.5/§6: Table I + Eq. 21 in projected angles == 3-D closed form, to 1e-10
+    # docs/models.md §2.5/§6: Table I + Eq. 21 in projected angles == 3-D closed form, to 1e-10
     ti, tr, ph = random_geometry(200_000, 1)
     np.testing.assert_allclose(S.v_groove_table(ti, tr, ph), S.v_groove(ti, tr, ph), atol=1e-10,
                                rtol=0)
@@ -59,7 +59,7 @@ def test_table_i_equals_closed_form_property(ti, tr, ph):
 
 
 def test_v_groove_is_v_cavity_formula():
-    # MODELS.md §2.5: G = min(1, 2 (z.h)(z.w_r)/(w_r.h), 2 (z.h)(z.w_i)/(w_r.h)) in vectors
+    # docs/models.md §2.5: G = min(1, 2 (z.h)(z.w_r)/(w_r.h), 2 (z.h)(z.w_i)/(w_r.h)) in vectors
     ti, tr, ph = random_geometry(20_000, 2)
     wi, wr = rb.geometry.unit_vectors(ti, tr, ph)
     h = wi + wr
@@ -84,8 +84,8 @@ def test_v_groove_bounds_symmetry_and_specular():
 
 
 def test_g21_limits():
-    # MODELS.md §2.5: A = 0 at theta_p* = (psi_p + pi)/3 gives G = 1 (L'Hopital); theta_p = pi/2
-    # gives A = 1, G = 0; at theta_p = -psi_p masking and shadowing forms agree
+    # docs/models.md §2.5: A = 0 at theta_p* = (psi_p + pi)/3 gives G = 1 (L'Hopital);
+    # theta_p = pi/2 gives A = 1, G = 0; at theta_p = -psi_p masking and shadowing forms agree
     for psi in np.radians([0.0, 10, 30, 45, 60, 80]):
         assert S.g21(psi, (psi + math.pi) / 3) == pytest.approx(1.0, abs=1e-12)
         assert S.g21(psi, HALF_PI) == pytest.approx(0.0, abs=1e-7)
@@ -94,7 +94,7 @@ def test_g21_limits():
 
 def test_g_over_cos_r_per_branch():
     # G/cos(theta_r) equals G / cos(theta_r) wherever that quotient is defined, and has the
-    # masking-branch value 2 cos(theta_h)/cos(theta_d) at theta_r = 90 deg (MODELS.md §2.5)
+    # masking-branch value 2 cos(theta_h)/cos(theta_d) at theta_r = 90 deg (docs/models.md §2.5)
     ti, tr, ph = random_geometry(50_000, 4)
     tr = np.minimum(tr, 1.5)
     np.testing.assert_allclose(S.g_over_cos_r(ti, tr, ph), S.v_groove(ti, tr, ph) / np.cos(tr),

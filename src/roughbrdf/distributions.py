@@ -19,7 +19,7 @@ sirohi              A2       cos^-2 a exp(-A2 tan^2 a)                          
 Normalizations: Trowbridge-Reitz ``1/(pi e^2)``; Beckmann ``1/(pi m^2)``; Berry
 ``(e^2 - 1)/(pi e^2 ln e^2)`` (``1/pi`` at e = 1); gaussian-angle and Sirohi by adaptive
 quadrature (SciPy ``quad``, cached per parameter value), because their integrals over the
-hemisphere have no elementary closed form. The Sirohi exponent is ``p = 2`` (MODELS.md §3.11,
+hemisphere have no elementary closed form. The Sirohi exponent is ``p = 2`` (docs/models.md §3.11,
 recommended reading); the ``p = 4`` variant is exactly Beckmann with ``m = 1/sqrt(A2)``.
 
 Smith's ``Lambda`` (needed by :mod:`roughbrdf.shadowing`) depends on D, so it lives here too,
@@ -212,7 +212,7 @@ def trowbridge_reitz_d(c, e):
     """Scalar part: normalized Trowbridge-Reitz/GGX ``e^2/(pi (e^2 c^2 + 1 - c^2)^2)``.
 
     The same value as ``evaluate_d(TR, c, e, 1/(pi e^2))``, as a small inlined part for the TR75
-    kernel (MODELS.md §3.7).
+    kernel (docs/models.md §3.7).
     """
     c = min(1.0, max(0.0, c))
     q = e * e * c * c + (1.0 - c * c)
@@ -277,7 +277,7 @@ def gaussian_angle(theta_h: ArrayLike, c: float) -> np.ndarray:
     """TS67 Eq. 5 ``b0 exp(-(c alpha)^2)`` with ``alpha = theta_h`` in degrees, ``c`` per degree.
 
     ``theta_h`` is in radians; ``b0`` is computed so that ``∫ D cos dω = 1`` (2.8316 sr⁻¹ for
-    c = 0.05/deg, MODELS.md §2.3).
+    c = 0.05/deg, docs/models.md §2.3).
     """
     th = as_float_array(theta_h, "theta_h")
     bad = ~np.isfinite(th) | (th < 0) | (th > 0.5 * math.pi)

@@ -3,7 +3,7 @@
 Conventions
 -----------
 * Complex index ``n + i k`` with ``k >= 0`` absorbing (TS67 and TR75 write ``n - i k``; the
-  reflectances are identical, the two indices being complex conjugates; MODELS.md §1.4).
+  reflectances are identical, the two indices being complex conjugates; docs/models.md §1.4).
 * ``n`` is the index of the reflecting medium relative to the incident one; ``n < 1`` is allowed
   (total internal reflection beyond the critical angle when ``k = 0``).
 * Polarization ``gamma`` (TR75 Eq. 24): angle of the incident electric field from the
@@ -40,7 +40,7 @@ __all__ = ["fresnel_sp", "fresnel_polarized", "fresnel_polarized_cs", "fresnel_p
 
 @jit(inline=True, contract=False)  # plain rounding: see roughbrdf._kernels.compile.jit
 def fresnel_sp(c, n, k):
-    """Scalar part: ``(R_s, R_p)`` at ``cos t = c`` for index ``n + i k`` (MODELS.md §1.4)."""
+    """Scalar part: ``(R_s, R_p)`` at ``cos t = c`` for index ``n + i k`` (docs/models.md §1.4)."""
     s2 = 1.0 - c * c
     re = n * n - k * k  # Re (n + ik)^2
     im = 2.0 * n * k  # Im (n + ik)^2

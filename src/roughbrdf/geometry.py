@@ -1,6 +1,6 @@
 """The common frame, conversions to each paper's own angles, and the derived angles.
 
-Common frame (MODELS.md §1.1, the only one used inside roughbrdf)
+Common frame (docs/models.md §1.1, the only one used inside roughbrdf)
 -----------------------------------------------------------------
 * mean-surface normal ``+z``; plane of incidence x-z; the source on the ``-x`` side;
 * ``theta_i`` incidence zenith, ``theta_r`` reflection zenith, ``phi`` azimuth of the reflected
@@ -155,7 +155,7 @@ def half_vector(ti, tr, phi):
 
 @jit
 def ts67_projected(ti, tr, phi):
-    """TS67 projected angles ``(psi_p, theta_p, alpha_signed)`` (MODELS.md §2.4, vector form).
+    """TS67 projected angles ``(psi_p, theta_p, alpha_signed)`` (docs/models.md §2.4, vector form).
 
     The projection plane is spanned by ``z`` and the horizontal direction ``u`` of the facet tilt;
     ``psi_p >= 0`` and ``theta_p = psi_p + 2 alpha_signed`` with the paper's sign convention
@@ -189,7 +189,7 @@ def tr75_eta_from_h(si, ci, hx, hy, hz):
 
     ``sin eta sin s = h_y`` and
     ``cos eta sin s = (w_i x h)_y = sin(theta_i) h_z + cos(theta_i) h_x``
-    (MODELS.md §3.5, recommended sign). At ``s = 0`` both vanish and eta = 0 (R_s = R_p
+    (docs/models.md §3.5, recommended sign). At ``s = 0`` both vanish and eta = 0 (R_s = R_p
     there); below ``sin s = 1e-12`` the two are round-off, and eta = 0 is returned too.
     Vectorizable (:func:`roughbrdf._kernels.vmath.vatan2`); the model kernels use the cheaper
     :func:`tr75_eta_xy` instead of the angle.
@@ -276,17 +276,17 @@ def theta_d(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> np.ndarra
 
 
 def phi_h(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> np.ndarray:
-    """Azimuth of the half vector in the common frame (MODELS.md §1.1), radians."""
+    """Azimuth of the half vector in the common frame (docs/models.md §1.1), radians."""
     return _phi_h(*check_angles(theta_i, theta_r, phi))
 
 
 def ts67_psi_p(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> np.ndarray:
-    """TS67 projected incidence angle psi_p >= 0 (MODELS.md §2.4)."""
+    """TS67 projected incidence angle psi_p >= 0 (docs/models.md §2.4)."""
     return _psi_p(*check_angles(theta_i, theta_r, phi))
 
 
 def ts67_theta_p(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> np.ndarray:
-    """TS67 projected reflection angle theta_p (signed, MODELS.md §2.4)."""
+    """TS67 projected reflection angle theta_p (signed, docs/models.md §2.4)."""
     return _theta_p(*check_angles(theta_i, theta_r, phi))
 
 
@@ -337,14 +337,15 @@ def from_ts67(psi: ArrayLike, theta: ArrayLike, phi: ArrayLike) -> tuple[np.ndar
 
 
 def to_ts67(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> tuple[np.ndarray, ...]:
-    """Common frame -> TS67 ``(psi, theta, phi)`` (identical conventions, MODELS.md §1.3)."""
+    """Common frame -> TS67 ``(psi, theta, phi)`` (identical conventions, docs/models.md §1.3)."""
     return tuple(np.asarray(v, dtype=float) for v in (theta_i, theta_r, phi))
 
 
 def from_tr75(beta: ArrayLike, elevation: ArrayLike, psi: ArrayLike) -> tuple[np.ndarray, ...]:
     """TR75 ``(beta, elevation theta, azimuth psi from the source side)`` -> common frame.
 
-    ``theta_r = pi/2 - elevation``, ``phi = pi - psi`` (MODELS.md §1.3; TR75 report Eqs. 9, 11).
+    ``theta_r = pi/2 - elevation``, ``phi = pi - psi`` (docs/models.md §1.3; TR75 report
+    Eqs. 9, 11).
     """
     b = np.asarray(beta, dtype=float)
     return b, HALF_PI - np.asarray(elevation, dtype=float), _wrap(np.pi - np.asarray(psi, float))
@@ -357,7 +358,7 @@ def to_tr75(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> tuple[np.
 
 
 def to_rb08(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> tuple[np.ndarray, ...]:
-    """Common frame -> RB08 direction cosines ``(alpha, beta, alpha0)`` (MODELS.md §4.3).
+    """Common frame -> RB08 direction cosines ``(alpha, beta, alpha0)`` (docs/models.md §4.3).
 
     ``alpha = sin theta_s cos phi``, ``beta = sin theta_s sin phi``, ``alpha0 = sin theta_i``;
     the specular point is ``(alpha0, 0)`` and the retro point ``(-alpha0, 0)``.

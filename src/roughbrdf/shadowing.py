@@ -11,7 +11,7 @@ quotient computed naively is 0/0. The scalar parts here return those quotients *
 TS67 V-groove
 -------------
 Table I of Torrance & Sparrow (1967) with Eq. 21, in the projected angles (psi_p, theta_p) of
-:func:`roughbrdf.geometry.ts67_projected`, is identical (MODELS.md §2.5, verified to 1e-12) to
+:func:`roughbrdf.geometry.ts67_projected`, is identical (docs/models.md §2.5, verified to 1e-12) to
 the 3-D "V-cavity" closed form
 
 .. math::  G = \\min\\{1,\\ 2\\cos\\theta_h\\cos\\theta_r/\\cos\\theta_d,\\
@@ -121,7 +121,7 @@ def _safe_div(a, b):
 
 @jit(inline=True)
 def v_groove_g(ci, cr, ch, cd):
-    """Scalar TS67 V-groove G from cosines (closed form, MODELS.md §2.5)."""
+    """Scalar TS67 V-groove G from cosines (closed form, docs/models.md §2.5)."""
     if cd <= 0.0:
         return 0.0  # w_i = -w_r (grazing, opposite): nothing reflects
     # + TINY: compiled code may evaluate this side also when cd = 0 (roughbrdf._kernels.vmath.TINY)
@@ -130,7 +130,7 @@ def v_groove_g(ci, cr, ch, cd):
 
 @jit(inline=True)
 def v_groove_g_over_cos_r(ci, cr, ch, cd):
-    """Scalar ``G/cos(theta_r)`` per branch (TS67; finite at theta_r = 90 deg, MODELS.md §2.5).
+    """Scalar ``G/cos(theta_r)`` per branch (TS67; finite at theta_r = 90 deg, docs/models.md §2.5).
 
     With ``m = 2 cos theta_h/cos theta_d``, ``G = min(1, m cos theta_r, m cos theta_i)``, so
     ``G/cos theta_r`` is, per branch: G = 1: ``1/cos theta_r``; masking (``cr <= ci``): ``m``
@@ -330,7 +330,7 @@ def smith(theta_i: ArrayLike, theta_r: ArrayLike, alpha: float,
 # --------------------------------------------------------------------------------------------
 # RB08: Renhorn & Boreman (2008) shadowing V (Eqs. 10-12) and masking multiplier Vm (Eqs. 13-15)
 # --------------------------------------------------------------------------------------------
-# MODELS.md §4.7-4.8. The scalar parts are used inside the RB08 model kernel
+# docs/models.md §4.7-4.8. The scalar parts are used inside the RB08 model kernel
 # (roughbrdf.models.renhorn_boreman); V and Vm below are their NumPy front ends.
 
 
@@ -414,7 +414,7 @@ def Vm(zeta: ArrayLike, zeta0: ArrayLike, w_a: ArrayLike, w_b: ArrayLike, gamma:
        delta: ArrayLike, alpha: ArrayLike | None = None) -> np.ndarray:
     """RB08 masking/shadowing multiplier ``Vm(zeta, zeta0, w_a, w_b, gamma, delta)`` (Eq. 13).
 
-    With the recommended signs (MODELS.md §4.8) ``E0 = exp(-gamma zeta0 exp(-delta zeta0²))``
+    With the recommended signs (docs/models.md §4.8) ``E0 = exp(-gamma zeta0 exp(-delta zeta0²))``
     and ``B = exp(-w_a zeta exp(-w_b alpha²))``::
 
         Vm = 1/2 (1 - E0) [Sgn(zeta) + 1] + B {1/2 [1 - Sgn(zeta)] + 1/2 E0 [Sgn(zeta) + 1]}

@@ -1,10 +1,11 @@
 """Special functions that must run inside compiled (Numba) kernels.
 
-Why hand-written: RB08's shadowing function (MODELS.md §4.7) is the regularized upper incomplete
-gamma function ``Q(a, x) = Γ(a, x)/Γ(a)``, evaluated per sample inside the model kernel. SciPy's
-``scipy.special.gammaincc`` cannot be called from Numba's nopython mode, so :func:`gammaincc_q`
-implements it as a Numba scalar. :func:`gammaincc` is its NumPy front end; the tests check it
-against ``scipy.special.gammaincc`` (a from 0.5 to 2000, x from 0 to far in the tail).
+Why hand-written: RB08's shadowing function (docs/models.md §4.7) is the regularized upper
+incomplete gamma function ``Q(a, x) = Γ(a, x)/Γ(a)``, evaluated per sample inside the model
+kernel. SciPy's ``scipy.special.gammaincc`` cannot be called from Numba's nopython mode, so
+:func:`gammaincc_q` implements it as a Numba scalar. :func:`gammaincc` is its NumPy front end;
+the tests check it against ``scipy.special.gammaincc`` (a from 0.5 to 2000, x from 0 to far in
+the tail).
 
 Method
 ------

@@ -1,8 +1,8 @@
 """Generate ``tr75_cement.csv``, the measurement embedded in the package (run once; seeded).
 
 A synthetic relative BRIDF of the cement surface of Trowbridge & Reitz (1975), Table 1
-(MODELS.md §3.10: e = 0.68, n = 1.00, k = 0.9, rho_L = 0.33), taken at TR75's own measurement
-design (MODELS.md §3.9):
+(docs/models.md §3.10: e = 0.68, n = 1.00, k = 0.9, rho_L = 0.33), taken at TR75's own measurement
+design (docs/models.md §3.9):
 
 * incidence beta in {0, 15, 30, 45, 60, 70} deg;
 * elevation in {15, 30, 45, 60, 75, 90} deg (theta_r = 90 deg - elevation);
@@ -65,7 +65,7 @@ def make(path: Path = OUT) -> Path:
         "# quantity: relative",
         "# relative_to: bridf",
         "# sample: TR75 cement (synthetic)",
-        "# instrument: synthetic, TR75 measurement design (MODELS.md 3.9)",
+        "# instrument: synthetic, TR75 measurement design (docs/models.md 3.9)",
         "# truth: trowbridge-reitz-1975 e=0.68 n=1.00 k=0.9 rho_L=0.33 (TR75 Table 1, cement)",
         f"# noise: multiplicative, 1 + {NOISE:g} N(0,1), numpy default_rng seed {SEED}",
         "# normalization: divided by the value at beta 0, elevation 90, perpendicular",

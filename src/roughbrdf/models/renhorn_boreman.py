@@ -1,7 +1,7 @@
 """Renhorn & Boreman (2008): analytical 14-parameter rough-surface BRDF (surface, bulk, retro).
 
 I. G. E. Renhorn and G. D. Boreman, "Analytical fitting model for rough-surface BRDF",
-Opt. Express 16(17), 12892-12898 (2008), doi:10.1364/OE.16.012892. MODELS.md §4 (reconstructed
+Opt. Express 16(17), 12892-12898 (2008), doi:10.1364/OE.16.012892. docs/models.md §4 (reconstructed
 from the 20 flattened equations of seed ``004_...``; the readings are listed there).
 
 Recommended reading, in the common frame (``alpha = sin theta_s cos phi``,
@@ -174,9 +174,9 @@ def _scatter(si, ci, rs0, rp0, v0, v0r, e0, ns, nr, ti, tr, phi, gamma, p, flag,
     ss, cs = sincos(tr)
     cs = 0.0 if cs < 1e-15 else cs  # cos(pi/2) = 6e-17: exact grazing gives exactly 0
     sph, cph = sincos(phi)
-    a = ss * cph  # direction cosines alpha, beta (MODELS.md §4.3)
+    a = ss * cph  # direction cosines alpha, beta (docs/models.md §4.3)
     b = ss * sph
-    # Fresnel at the macroscopic angles (Eqs. 16-17 = fresnel_sp, MODELS.md §4.9); a per-call
+    # Fresnel at the macroscopic angles (Eqs. 16-17 = fresnel_sp, docs/models.md §4.9); a per-call
     # polarization angle g gives R = R_s sin^2 g + R_p cos^2 g, NaN the option's weight
     unpol = gamma != gamma
     sg, cg = sincos(0.0 if unpol else gamma)
@@ -213,7 +213,7 @@ def _scatter(si, ci, rs0, rp0, v0, v0r, e0, ns, nr, ti, tr, phi, gamma, p, flag,
         vsr = vs
     else:
         vsr = vs if p[_SAME_V] == 1.0 else _v(ss, p[_SC_R], p[_A_R], p[_ST_R], fast)
-    # retro_shadowing: "width" (MODELS.md §4.10) V(sin theta_i) V(sin theta_s) narrows the
+    # retro_shadowing: "width" (docs/models.md §4.10) V(sin theta_i) V(sin theta_s) narrows the
     # width term; "amplitude" it multiplies the strength (the acceptance-angle cut-off)
     amp = p[_RAMP] == 1.0
     vr = v0r * vsr
@@ -509,11 +509,11 @@ class RenhornBoreman2008(Model):
     """Renhorn & Boreman (2008) analytical rough-surface BRDF: surface, bulk and retro terms.
 
     I. G. E. Renhorn and G. D. Boreman, "Analytical fitting model for rough-surface BRDF",
-    Opt. Express 16(17), 12892 (2008), Eqs. 5-20, as reconstructed in MODELS.md §4. Only the
+    Opt. Express 16(17), 12892 (2008), Eqs. 5-20, as reconstructed in docs/models.md §4. Only the
     flattened equations of the paper survive, so some parts are *our reading*; every alternative
     reading is an option.
 
-    Parameters (the fourteen of the abstract, MODELS.md §4.11)
+    Parameters (the fourteen of the abstract, docs/models.md §4.11)
     ----------------------------------------------------------
     rho : float > 0
         Surface-lobe width: half width at half maximum of the Lorentzian in direction-cosine
@@ -540,9 +540,9 @@ class RenhornBoreman2008(Model):
         term's Lambertian shape is *our reading* (the shapes were defined in the lost prose).
     rho_r, w_r, n_r : float
         Retro lobe width and its own shadowing pair. *Our reading:* ``rho_r`` is probable (a
-        retro lobe needs a width), ``w_r``, ``n_r`` speculative (MODELS.md §4.11).
+        retro lobe needs a width), ``w_r``, ``n_r`` speculative (docs/models.md §4.11).
 
-    Options (the alternative readings; defaults are MODELS.md's recommendations)
+    Options (the alternative readings; defaults are docs/models.md's recommendations)
     ----------------------------------------------------------------------------
     zeta : {"angle", "cosine", "zenith-difference"}
         What Vm's ``zeta``, ``zeta0`` are (§4.8): ``"angle"`` ``zeta = arcsin(sin theta_s cos
@@ -573,9 +573,9 @@ class RenhornBoreman2008(Model):
         ``None``/NaN uses the option.
     retro_shadowing : {"width", "amplitude"}
         Where the retro lobe's own shadowing pair ``V(sin theta_i, w_r, n_r) V(sin theta_s,
-        w_r, n_r)`` acts. Parameters 13-14 (``w_r``, ``n_r``) are *speculative* (MODELS.md
+        w_r, n_r)`` acts. Parameters 13-14 (``w_r``, ``n_r``) are *speculative* (docs/models.md
         §4.10-4.11: the retro shape was in the lost prose), so both are *our reading*.
-        ``"width"`` (default, MODELS.md §4.10): the surface lobe mirrored to the retro point,
+        ``"width"`` (default, docs/models.md §4.10): the surface lobe mirrored to the retro point,
         the pair multiplying ``rho_r^2`` in the width term as V does in Eq. 12. Its retro peak
         ``BRDF cos theta_s = (1 - R(theta_i)) retro N(alpha0, rho_r)/(cos theta_i V(sin
         theta_i)^2 rho_r^2)`` can only *grow* with incidence (V <= 1 decreasing; for
@@ -595,8 +595,8 @@ class RenhornBoreman2008(Model):
     -----
     * The Fresnel factor is evaluated at the macroscopic angles ``theta_i`` and ``theta_s``
       (Eqs. 16-17 written in the direction cosine are exactly the standard Fresnel equations,
-      MODELS.md §4.9), with :func:`roughbrdf.fresnel.fresnel_sp`.
-    * **Not reciprocal** (MODELS.md §4.13): the denominators and ``sigma_s`` (q = 1/2) are
+      docs/models.md §4.9), with :func:`roughbrdf.fresnel.fresnel_sp`.
+    * **Not reciprocal** (docs/models.md §4.13): the denominators and ``sigma_s`` (q = 1/2) are
       symmetric in ``(theta_i, theta_s)``, but ``N(alpha0, rho)`` depends on the incidence only
       and Vm distinguishes incidence from scattering, so ``f(i, s) != f(s, i)`` in general. Energy
       conservation is not guaranteed either (the model is a fitting function).
@@ -609,14 +609,14 @@ class RenhornBoreman2008(Model):
       to 0 (extremely sharp shadowing, ``n`` in the hundreds with ``sin theta_i > w``) the same
       happens at the peak, which then returns ``inf`` (never NaN).
     * ``term="surface" | "bulk" | "retro"`` evaluates one term alone.
-    * The sigma of Eqs. 5-15 is ``sigma_surface`` itself (no separate free scale, MODELS.md
+    * The sigma of Eqs. 5-15 is ``sigma_surface`` itself (no separate free scale, docs/models.md
       §4.10): the 14 parameters of the abstract are then exactly the list above.
     * Defaults: a matte-paint-like surface, no published values being available: index 1.5
       (R = 4 % at normal incidence), a broad weak gloss lobe (rho = 0.3, w = 0.9, n = 4), a
       strong bulk term (bulk = 0.85), a faint retro lobe (retro = 0.02, rho_r = 0.2) and Vm
       switched off (w_a = 0). Directional-hemispherical reflectance 0.87 at normal incidence,
       0.89 at 60 deg with ``normalization="specular-width"``; with the literal N it exceeds 1
-      beyond ~60 deg (1.75 at 80 deg: the lobe's integral grows as in MODELS.md §4.12).
+      beyond ~60 deg (1.75 at 80 deg: the lobe's integral grows as in docs/models.md §4.12).
 
     Examples
     --------

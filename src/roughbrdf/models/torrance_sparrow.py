@@ -1,13 +1,13 @@
 """Torrance & Sparrow (1967): V-groove facets, gaussian slope-angle distribution, Fresnel.
 
 K. E. Torrance and E. M. Sparrow, "Theory for off-specular reflection from roughened surfaces",
-J. Opt. Soc. Am. 57(9), 1105-1114 (1967). MODELS.md §2.
+J. Opt. Soc. Am. 57(9), 1105-1114 (1967). docs/models.md §2.
 
-Absolute form (from Eq. 12, MODELS.md §2.3)::
+Absolute form (from Eq. 12, docs/models.md §2.3)::
 
     f_r = (rho_d/pi) [ g F(theta_d) G exp(-c^2 alpha^2) / (cos theta_i cos theta_r) + 1 ]
 
-with ``alpha = theta_h`` in degrees and ``c`` per degree (MODELS.md §2.3), ``G`` the V-groove
+with ``alpha = theta_h`` in degrees and ``c`` per degree (docs/models.md §2.3), ``G`` the V-groove
 attenuation factor (Table I = the 3-D closed form), ``F`` the Fresnel reflectance at the local
 angle ``theta_d`` (unpolarized unless a polarization is given; ``n=None`` gives ``F = 1``), and
 ``g = b f dω_i/(4 a)`` the paper's ratio of facet to diffuse contributions. The first term is the
@@ -52,7 +52,7 @@ def _ts67_eval(ti, tr, phi, gamma, p, flag, use_f):
         # G/cos(theta_i) per branch (symmetry of G): finite also where cos(theta_i) rounds to 0
         geo = v_groove_g_over_cos_r(cr, ci, hz, cd)
         return rho_d / math.pi * ((t * geo if t > 0.0 else 0.0) + cr)
-    # G/(cos theta_i cos theta_r) per branch: finite at theta_r = 90 deg (MODELS.md §2.5) and
+    # G/(cos theta_i cos theta_r) per branch: finite at theta_r = 90 deg (docs/models.md §2.5) and
     # where cos(theta_i) rounds to 0; t = 0 (gaussian underflow) gives 0, never 0 * inf
     geo = v_groove_g_over_cos_cos(ci, cr, hz, cd)
     return rho_d / math.pi * ((t * geo if t > 0.0 else 0.0) + 1.0)
@@ -88,7 +88,7 @@ def _ts67_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
 
 @register
 class TorranceSparrow1967(Model):
-    """Torrance-Sparrow (1967) off-specular reflection model (MODELS.md §2).
+    """Torrance-Sparrow (1967) off-specular reflection model (docs/models.md §2).
 
     Parameters
     ----------
@@ -106,13 +106,13 @@ class TorranceSparrow1967(Model):
     -----
     Angles are the common frame (TS67's own psi, theta, phi are the same). ``theta_i`` must be
     below 90 deg (Eq. 23's denominator ``g F/cos psi`` diverges). The model is finite at
-    ``theta_r = 90 deg`` through the per-branch ``G/cos theta_r`` (MODELS.md §2.5).
+    ``theta_r = 90 deg`` through the per-branch ``G/cos theta_r`` (docs/models.md §2.5).
 
     Examples
     --------
     >>> import numpy as np, roughbrdf as rb
     >>> ts = rb.model("torrance-sparrow-1967", g=2/3, c=0.05, n=None, k=None, rho_d=0.3)
-    >>> round(float(ts.relative(np.radians(75), np.radians(80), 0.0)), 3)   # MODELS.md §2.7
+    >>> round(float(ts.relative(np.radians(75), np.radians(80), 0.0)), 3)   # docs/models.md §2.7
     1.425
     """
 

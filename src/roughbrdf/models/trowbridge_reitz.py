@@ -2,7 +2,7 @@
 
 T. S. Trowbridge and K. P. Reitz, "Average irregularity representation of a rough surface for
 ray reflection", J. Opt. Soc. Am. 65(5), 531-536 (1975); Naval Missile Center report TP-75-01.
-MODELS.md §3.
+docs/models.md §3.
 
 BRIDF (Eqs. 30, 32, 33), in sr⁻¹::
 
@@ -12,7 +12,7 @@ BRIDF (Eqs. 30, 32, 33), in sr⁻¹::
 with ``beta = theta_i``, ``alpha = theta_h``, ``s = theta_d``, ``sin(theta_elev) = cos theta_r``.
 The specular part equals ``R D/(4 cos theta_i)`` with ``D`` the normalized Trowbridge-Reitz (GGX,
 alpha = e) distribution. ``brdf = bridf/cos theta_r``. ``R`` follows Eq. 24 with the angle ``eta``
-between the local and macroscopic planes of incidence (MODELS.md §3.5).
+between the local and macroscopic planes of incidence (docs/models.md §3.5).
 
 The published model has no shadowing, so its BRDF diverges at ``theta_r = 90 deg``: there
 ``brdf()`` returns its limit ``inf`` while ``bridf()`` stays finite. The report's footnote allows
@@ -38,13 +38,13 @@ from .parameters import nonnegative, positive, unit_interval
 def _tr75_point(ti, tr, phi, gamma, p, flag):
     e, n, k, rho_l, shadow = p[0], p[1], p[2], p[3], p[4]
     hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
-    ex, ey = tr75_eta_xy(si, ci, hx, hy, hz)  # sin(s) (cos, sin) eta, Eq. 23 (MODELS.md §3.5)
+    ex, ey = tr75_eta_xy(si, ci, hx, hy, hz)  # sin(s) (cos, sin) eta, Eq. 23 (docs/models.md §3.5)
     r = fresnel_polarized_xy(cd, n, k, gamma, ex, ey)
     spec4 = 0.25 * r * dist.trowbridge_reitz_d(hz, e)  # R D/4; Eq. 30 = spec4/cos(theta_i)
     if flag:  # BRIDF, Eq. 33
         if shadow > 0.0:  # G/cos(theta_i) per branch (G symmetric), finite at grazing
             spec = spec4 * shd.v_groove_g_over_cos_r(cr, ci, hz, cd)
-        else:  # Eq. 30 diverges as 1/cos(beta) at grazing incidence (MODELS.md §3.13): inf
+        else:  # Eq. 30 diverges as 1/cos(beta) at grazing incidence (docs/models.md §3.13): inf
             spec = spec4 / ci if ci > 0.0 else math.inf
         return spec + cr * rho_l / math.pi
     # BRDF = BRIDF / cos(theta_r)
@@ -70,7 +70,7 @@ def _tr75_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
 
 @register
 class TrowbridgeReitz1975(Model):
-    """Trowbridge-Reitz (1975) ellipsoid model plus a Lambertian part (MODELS.md §3).
+    """Trowbridge-Reitz (1975) ellipsoid model plus a Lambertian part (docs/models.md §3).
 
     Parameters
     ----------

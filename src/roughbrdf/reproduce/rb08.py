@@ -1,7 +1,7 @@
 """Renhorn & Boreman (2008): Fig. 2 (Vm against scattering angle) and Fig. 3 (in-plane BRDF).
 
 I. G. E. Renhorn and G. D. Boreman, "Analytical fitting model for rough-surface BRDF",
-Opt. Express 16(17), 12892-12898 (2008). Targets: MODELS.md §4.14.
+Opt. Express 16(17), 12892-12898 (2008). Targets: docs/models.md §4.14.
 
 The paper's fitted parameter values and its measured data are not available (seed ``004_...``
 has the abstract, the three figure captions and flattened equations only). The figures use
@@ -86,7 +86,7 @@ GRAY_TAPE_FILE = Path("cea_retro") / "retro-gray-tape.dat"
 def model(params: dict | None = None, options: dict | None = None) -> rb.Model:
     """The RB08 model with ``params`` (default :data:`PARAMS`).
 
-    ``options`` (model readings, MODELS.md §4) default to :data:`OPTIONS` for :data:`PARAMS`
+    ``options`` (model readings, docs/models.md §4) default to :data:`OPTIONS` for :data:`PARAMS`
     (the gray-tape fit was made with ``retro_shadowing="amplitude"``) and to the model's default
     readings for any other parameter set.
     """
@@ -120,7 +120,7 @@ def _vm(zeta: np.ndarray, theta_i_deg: float, p: dict) -> np.ndarray:
 def fig2(params: dict | None = None) -> Reproduction:
     """Fig. 2: the masking/shadowing multiplier Vm against scattering angle, two incidences.
 
-    Reading Z-a of MODELS.md §4.8: ζ = signed in-plane scattering angle (radians; > 0 forward),
+    Reading Z-a of docs/models.md §4.8: ζ = signed in-plane scattering angle (radians; > 0 forward),
     ζ0 = θi; Vm = B for ζ < 0 (the same for every incidence) and 1 − E0 (1 − B) for ζ > 0.
     """
     p = params or PARAMS
@@ -144,7 +144,7 @@ def fig2(params: dict | None = None) -> Reproduction:
                  fontsize="small")
     ax.grid(True, alpha=0.3)
     ax.legend()
-    # identities of MODELS.md §4.8, evaluated through the public API
+    # identities of docs/models.md §4.8, evaluated through the public API
     checks = []
     eps = 1e-9
     for ti in INCIDENCES_FIG2:
@@ -164,7 +164,8 @@ def fig2(params: dict | None = None) -> Reproduction:
          "checks": Table(["theta_i_deg", "E0", "vm_at_0", "jump_at_0", "max_piecewise_error"],
                          checks)},
         notes=[f"Parameters: {_source(params)}.",
-               "ζ read as the signed in-plane scattering angle, ζ0 = θi (MODELS.md §4.8, Z-a)."])
+               "ζ read as the signed in-plane scattering angle, ζ0 = θi "
+               "(docs/models.md §4.8, Z-a)."])
 
 
 def _gray_tape(data_dir: str | Path | None):

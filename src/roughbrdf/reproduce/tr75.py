@@ -2,7 +2,7 @@
 
 T. S. Trowbridge and K. P. Reitz, "Average irregularity representation of a rough surface for
 ray reflection", J. Opt. Soc. Am. 65(5), 531-536 (1975); Naval Missile Center report TP-75-01.
-Targets: MODELS.md §3.10-3.12.
+Targets: docs/models.md §3.10-3.12.
 
 TR75's angles: β (incidence zenith), θ (reflection **elevation**) and ψ (azimuth, 0 toward the
 source), converted to the common frame with :func:`roughbrdf.geometry.from_tr75`.
@@ -25,10 +25,10 @@ from ._common import Reproduction, Table, new_figure
 __all__ = ["STRUCTURE_FUNCTIONS", "TABLE1", "hwhm", "fig5", "fig6", "table1", "ALL"]
 
 #: TR75 Fig. 5 (report) / Fig. 4 (JOSA): best fits to Rense's ground-glass data, as
-#: ``(label, registered distribution, parameter, caption parameter)`` (MODELS.md §3.11).
+#: ``(label, registered distribution, parameter, caption parameter)`` (docs/models.md §3.11).
 #: Beckmann's ``cos^-4 exp(-A^2 tan^2)`` is our ``beckmann`` with ``m = 1/A``; Rense's
 #: ``exp(-A^2 alpha^2)`` with ``A^2 = 0.0021 deg^-2`` is TS67's gaussian in the facet angle with
-#: ``c = A = 0.0458 per degree``; Sirohi is read with ``p = 2`` (MODELS.md §3.11, recommended).
+#: ``c = A = 0.0458 per degree``; Sirohi is read with ``p = 2`` (docs/models.md §3.11, recommended).
 STRUCTURE_FUNCTIONS = (
     ("TR75 e⁴/(e²cos²α + sin²α)²", "trowbridge-reitz", 0.40, "e = 0.40"),
     ("Berry e²/(e²cos²α + sin²α)", "berry", 0.25, "e = 0.25"),
@@ -39,7 +39,7 @@ STRUCTURE_FUNCTIONS = (
 #: the alternative reading of the Sirohi exponent (p = 4) equals Beckmann with m = 1/sqrt(6.93)
 SIROHI_P4 = ("Sirohi read with cos⁻⁴α (p = 4)", "beckmann", 1.0 / math.sqrt(6.93), "A² = 6.93")
 
-#: Table 1 (MODELS.md §3.10 transcription): sigma_m, rho_L, e, n, k; the paper's DHR estimate
+#: Table 1 (docs/models.md §3.10 transcription): sigma_m, rho_L, e, n, k; the paper's DHR estimate
 #: at normal incidence ("order of ...") and the measured DHR it quotes.
 TABLE1 = (
     {"surface": "3M Black Velvet (min 1)", "key": "black_velvet_1", "sigma_m": 0.290,
@@ -173,7 +173,7 @@ def fig6(columns: tuple[tuple[float, float], ...] = FIG6_COLUMNS) -> Reproductio
                  "(ψ = 0° toward the source, 180° forward)", fontsize="medium")
     fig.legend(handles, ["⊥ incident polarization (s)", "∥ incident polarization (p)"],
                loc="outside lower center", ncols=2, fontsize="small")
-    # MODELS.md §3.12 check values: cement, unpolarized, beta = 45 deg
+    # docs/models.md §3.12 check values: cement, unpolarized, beta = 45 deg
     cement = surface_model(next(r for r in TABLE1 if r["key"] == "cement"))
     checks = []
     for elev in (15.0, 45.0, 75.0, 90.0):
@@ -217,7 +217,7 @@ def table1() -> Reproduction:
     od_alt = float(rb.albedo(surface_model(od, rho_L=0.006), 0.0))
     md = ["# TR75 Table 1: optimum parameters and directional-hemispherical reflectance",
           "",
-          "Parameters as transcribed in MODELS.md §3.10 (Black Velvet has two nearly equal "
+          "Parameters as transcribed in docs/models.md §3.10 (Black Velvet has two nearly equal "
           "minima). DHR at normal incidence, unpolarized, computed with `rb.albedo` from the "
           "TR75 model (Eqs. 30 + 32): *interface* is the ellipsoid term alone, *total* adds "
           "ρ_L. The paper's estimate is its \"order of\" value from the absolute BRIDF.",
@@ -239,7 +239,7 @@ def table1() -> Reproduction:
     md += ["",
            f"Olive drab: ρ_L = 0.06 alone exceeds the paper's \"order of 5 %\"; our total is "
            f"{rows[2][7]:.3f}, about twice the estimate. With ρ_L = 0.006 (a dropped zero in "
-           f"the OCR'd table, MODELS.md §3.10) the total would be {od_alt:.3f}. Grass: ours "
+           f"the OCR'd table, docs/models.md §3.10) the total would be {od_alt:.3f}. Grass: ours "
            f"and the paper's estimate agree (~60 %), and both disagree with the 5-20 % "
            f"measured for meadows, as the paper itself says.", ""]
     return Reproduction(

@@ -1,7 +1,7 @@
 """Torrance & Sparrow (1967): Figs. 7, 8, 9, 10 and 11 from the library's public API.
 
 K. E. Torrance and E. M. Sparrow, "Theory for off-specular reflection from roughened surfaces",
-J. Opt. Soc. Am. 57(9), 1105-1114 (1967). Targets: MODELS.md §2.7.
+J. Opt. Soc. Am. 57(9), 1105-1114 (1967). Targets: docs/models.md §2.7.
 
 All curves are in TS67's own angles, which are the library's common frame: ψ (incidence zenith)
 = ``theta_i``, θ = ``theta_r`` and φ = ``phi`` (0 forward). In-plane plots use the paper's
@@ -39,12 +39,13 @@ PSI_FIG8 = (10.0, 30.0, 45.0, 60.0, 75.0)
 PSI_OUT_OF_PLANE = (30.0, 60.0, 75.0)
 PHI_FAMILY = (0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0)
 
-#: Fig. 7 target columns (MODELS.md §2.7), signed θ in degrees.
+#: Fig. 7 target columns (docs/models.md §2.7), signed θ in degrees.
 FIG7_THETAS = (-89.9, -80.0, -60.0, -45.0, -30.0, 0.0, 30.0, 45.0, 60.0, 75.0, 80.0, 85.0, 89.9)
 
 #: Optical constants at λ = 0.5 µm for Fig. 9 (complex index n + ik).
 #:
-#: The paper took its indices from the AIP Handbook (1963) without printing them (MODELS.md §7).
+#: The paper took its indices from the AIP Handbook (1963) without printing them
+#: (docs/models.md §7).
 #: We use published modern values near 500 nm:
 #:
 #: * aluminium: n = 0.77, k = 6.08 -- A. D. Rakić, "Algorithm for the determination of
@@ -52,13 +53,13 @@ FIG7_THETAS = (-89.9, -80.0, -60.0, -45.0, -30.0, 0.0, 30.0, 45.0, 60.0, 75.0, 8
 #:   4755-4767 (1995) (values at 0.50 µm as tabulated from that paper, e.g. on
 #:   refractiveindex.info);
 #:   the Palik *Handbook of Optical Constants of Solids* (1985, Al by Shiles et al.) gives values
-#:   within a few per cent at the same wavelength. These are also MODELS.md §2.7's values.
+#:   within a few per cent at the same wavelength. These are also docs/models.md §2.7's values.
 #: * magnesium oxide (MgO): n = 1.746, k = 0 -- R. E. Stephens and I. H. Malitson, "Index of
 #:   refraction of magnesium oxide", J. Res. Natl. Bur. Stand. 49, 249-252 (1952): n falls from
 #:   1.845 at 0.2537 µm through n_D = 1.7375 (0.5893 µm) to 1.731 at 0.7065 µm; at 0.5 µm it is
-#:   1.746 to three decimals. MODELS.md §2.7 rounds it to 1.74.
+#:   1.746 to three decimals. docs/models.md §2.7 rounds it to 1.74.
 #:
-#: g follows MODELS.md §2.7: 2/3 for aluminium, 2 for MgO (the paper chose g so that
+#: g follows docs/models.md §2.7: 2/3 for aluminium, 2 for MgO (the paper chose g so that
 #: g·F(75°) ≈ 2/3).
 OPTICAL_CONSTANTS = {
     "aluminium": {"n": 0.77, "k": 6.08, "g": 2.0 / 3.0,
@@ -67,7 +68,7 @@ OPTICAL_CONSTANTS = {
             "source": "Stephens & Malitson, J. Res. NBS 49, 249 (1952), 0.50 um"},
 }
 
-_C = 0.05  # per degree (MODELS.md §2.3)
+_C = 0.05  # per degree (docs/models.md §2.3)
 _G = 2.0 / 3.0
 
 
@@ -139,7 +140,8 @@ def fig7() -> Reproduction:
 # Fig. 8 and Fig. 9
 # --------------------------------------------------------------------------------------------
 def peak_table(model: rb.Model, psis: tuple[float, ...] = PSI_FIG8) -> Table:
-    """Forward maximum of Eq. 23 (0.01° grid up to 89.99°) and the ratios MODELS.md §2.7 lists."""
+    """Forward maximum of Eq. 23 (0.01° grid up to 89.99°) and the ratios docs/models.md §2.7
+    lists."""
     xs = np.round(np.arange(0.0, 89.995, 0.01), 2)
     rows = []
     for psi in psis:
@@ -240,7 +242,7 @@ def _phi_family(values, ylabel: str, title: str, ylims, logs=(False, False, Fals
 
 
 def _phi_row(values) -> Table:
-    """MODELS.md §2.7 check row: ψ = 75°, θ = 80°, φ = 0…180°."""
+    """docs/models.md §2.7 check row: ψ = 75°, θ = 80°, φ = 0…180°."""
     row = [float(values(75.0, np.array([80.0]), phi)[0]) for phi in PHI_FAMILY]
     return Table(["psi_deg", "theta_deg", *(f"phi_{p:g}" for p in PHI_FAMILY)],
                  [[75.0, 80.0, *row]])

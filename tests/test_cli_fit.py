@@ -150,3 +150,31 @@ def test_bad_aperture_is_a_clean_error(tmp_path, bad):
     res = _fit(DEFAULT, "--model", "ts67", "--aperture", bad, "--out", tmp_path / "x")
     assert res.exit_code == 2
     assert "--aperture must be a half-angle in degrees" in res.output
+
+
+def test_free_scale_option_fits_a_data_scale_on_absolute_data(tmp_path):
+    """--free-scale: absolute data off by a calibration factor give the model's parameters and
+    K = 1/factor (rb.fit(..., free_scale=True)); without it the scale stays 1."""
+    t_i, t_r, p = np.meshgrid(np.radians([0, 20, 40, 60]), np.radians(np.arange(0, 86, 5)),
+                              np.radians(np.arange(0, 181, 30)), indexing="ij")
+    truth = {"e": 0.3, "n": 1.5, "k": 0.0, "rho_L": 0.1}
+    f = rb.model("trowbridge-reitz-1975", **truth).brdf(t_i, t_r, p)
+    rows = [f"{a:.9g},{b:.9g},{c:.9g},{2.0 * v:.12g}"
+            for a, b, c, v in zip(t_i.ravel(), t_r.ravel(), p.ravel(), f.ravel(), strict=True)]
+    path = tmp_path / "scaled.csv"
+    path.write_text("# angles: rad\n# quantity: brdf\ntheta_i,theta_r,phi,value\n"
+                    + "\n".join(rows) + "\n")
+    # n and k fixed: the Fresnel factor then sets the absolute scale, so K is identifiable
+    args = (path, "-m", "tr75", "-p", "n=1.5", "-p", "k=0", "--fix", "n", "--fix", "k",
+            "--starts", "2", "--no-plots", "-q")
+    res = _fit(*args, "--free-scale", "--out", tmp_path / "free")
+    assert res.exit_code == 0, res.output
+    ch = json.loads((tmp_path / "free" / "fit.json").read_text())["channels"][0]
+    assert ch["scale"] == pytest.approx(0.5, rel=1e-4)
+    for name in ("e", "rho_L"):
+        assert ch["params"][name] == pytest.approx(truth[name], rel=1e-4)
+    res = _fit(*args, "--out", tmp_path / "fixed")
+    assert res.exit_code == 0, res.output
+    ch = json.loads((tmp_path / "fixed" / "fit.json").read_text())["channels"][0]
+    assert ch["scale"] == 1.0
+    assert not list(tmp_path.glob("*/*.png"))

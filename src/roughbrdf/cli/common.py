@@ -1,11 +1,19 @@
-"""Helpers shared by the CLI verbs: parsing ``-p name=value`` and degree ranges."""
+"""Helpers shared by the CLI verbs: parsing ``-p name=value`` and degree ranges.
+
+Like every module of :mod:`roughbrdf.cli`, this one imports nothing heavy at module level (NumPy,
+the models, SciPy, Matplotlib are imported inside the functions that use them), so that
+``roughbrdf --help`` and the argument checks stay fast; ``tests/test_startup.py`` checks it.
+"""
 
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
-import numpy as np
 import typer
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 def parse_params(items: list[str] | None) -> dict[str, float | None | str]:
@@ -28,6 +36,8 @@ def parse_params(items: list[str] | None) -> dict[str, float | None | str]:
 
 def degree_range(text: str, name: str) -> np.ndarray:
     """``"30"`` or ``"0:90:5"`` (start:stop:step, stop inclusive) in degrees -> radians."""
+    import numpy as np
+
     try:
         parts = [float(x) for x in text.split(":")]
     except ValueError as exc:

@@ -7,8 +7,10 @@ from typing import Annotated
 
 import typer
 
-from .. import io as _io
-from ..measurement import QUANTITIES
+#: the quantities a measurement can hold, for the help text (the same as
+#: :data:`roughbrdf.measurement.QUANTITIES`, written out so that ``--help`` imports no NumPy/Numba;
+#: the command itself checks against the library's tuple)
+HELP_QUANTITIES = ("brdf", "brdf_cos", "bridf", "relative")
 
 
 def register(app: typer.Typer) -> None:
@@ -21,7 +23,7 @@ def register(app: typer.Typer) -> None:
                                   "default from the extension"),
         to: str = typer.Option(None, "--to", help="output format; default from the extension"),
         quantity: str = typer.Option(None, "--quantity", help="what the input values hold when "
-                                     f"the file does not say: {', '.join(QUANTITIES)}"),
+                                     f"the file does not say: {', '.join(HELP_QUANTITIES)}"),
         as_quantity: str = typer.Option(None, "--as", help="convert the values to this quantity "
                                         "before writing (brdf <-> brdf_cos)"),
         angles_in: str = typer.Option(None, "--angles-in", help="angle unit of the input "
@@ -36,6 +38,9 @@ def register(app: typer.Typer) -> None:
 
         Non-finite and negative values are carried over and reported, never dropped.
         """
+        from .. import io as _io
+        from ..measurement import QUANTITIES
+
         try:
             if quantity is not None and quantity not in QUANTITIES:
                 raise ValueError(f"--quantity must be one of {', '.join(QUANTITIES)}, "

@@ -5,10 +5,8 @@ from __future__ import annotations
 import sys
 from typing import Annotated
 
-import numpy as np
 import typer
 
-from .. import models as _models
 from .common import degree_range, parse_params
 
 
@@ -16,6 +14,8 @@ def register(app: typer.Typer) -> None:
     @app.command("models")
     def models_cmd() -> None:
         """List the registered models with their parameters and units."""
+        from .. import models as _models
+
         for name in _models.available():
             m = _models.model(name)
             typer.echo(m.describe())
@@ -37,6 +37,10 @@ def register(app: typer.Typer) -> None:
         quantity: Annotated[str, typer.Option(help="brdf or bridf")] = "brdf",
     ) -> None:
         """Evaluate a model on a grid of angles (degrees) and print CSV."""
+        import numpy as np
+
+        from .. import models as _models
+
         try:
             m = _models.model(model, **parse_params(param))
             ti = degree_range(theta_i, "--theta-i")

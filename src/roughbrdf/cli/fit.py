@@ -8,27 +8,35 @@ per channel into DIR. ``--aperture DEG`` compares each sample with the model ave
 cone of that half-angle (degrees) about the measured reflection direction (``rb.fit(...,
 aperture=radians)``). DIR may exist: files roughbrdf wrote there before are replaced, any other file
 of the same name is left alone and the command stops (``--force`` overrides); see
-:mod:`roughbrdf._outdir`.
+:mod:`roughbrdf._outdir`. ``--free-scale`` fits a closed-form scale ``K`` of the data also for
+absolute data (``rb.fit(..., free_scale=True)``), ``--no-plots`` skips the figures (and
+Matplotlib).
 """
 
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from .. import models as _models
 from .common import parse_params
 
+if TYPE_CHECKING:
+    from ..models import Model
 
-def build_model(spec: str, params: dict[str, Any] | None = None) -> _models.Model:
+
+def build_model(spec: str, params: dict[str, Any] | None = None) -> Model:
     """A model from ``name`` or ``name1+name2`` and ``-p`` settings (:func:`roughbrdf.model`)."""
+    from .. import models as _models
+
     return _models.model(spec, **(params or {}))
 
 
-def resolve_names(model: _models.Model, names: list[str]) -> list[str]:
+def resolve_names(model: Model, names: list[str]) -> list[str]:
     """Map ``--fix`` names to the model's parameter names (plain names allowed in sums)."""
+    from .. import models as _models
+
     return _models.resolve_names(model, names)
 
 
@@ -59,6 +67,9 @@ def register(app: typer.Typer) -> None:
         nonfinite: str = typer.Option("raise", help="non-finite values: raise or drop"),
         negative: str = typer.Option("keep", help="negative values: keep, drop or clip"),
         seed: int = typer.Option(0, help="seed of the Sobol starts and the subsample"),
+        free_scale: bool = typer.Option(None, "--free-scale/--no-free-scale",
+                                        help="fit a free scale K of the data in closed form "
+                                             "(x -> K x; default: only for relative data)"),
         aperture: float = typer.Option(None, "--aperture", metavar="DEG",
                                        help="instrument aperture: half-angle in degrees of a "
                                             "uniform cone about the reflection direction; the "
@@ -86,7 +97,7 @@ def register(app: typer.Typer) -> None:
             # labels or positions as text; Measurement.channel_index resolves both ("525" also
             # finds "525nm")
             res = fit(m, meas, channel=list(channel) if channel else None, loss=loss, fix=fixed,
-                      starts=starts, seed=seed,
+                      starts=starts, seed=seed, free_scale=free_scale,
                       nonfinite=nonfinite, negative=negative, relative_to=relative_to,
                       aperture=None if aperture is None else math.radians(aperture),
                       progress=None if not quiet else False)

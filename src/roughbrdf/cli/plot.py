@@ -8,7 +8,6 @@ import re
 from pathlib import Path
 from typing import Annotated, Any
 
-import numpy as np
 import typer
 
 from .common import degree_range, parse_params
@@ -30,6 +29,8 @@ def _check_out(path: Path, force: bool) -> None:
 
 def _model_figure(model_name: str, params: dict[str, Any], kind: str, theta_i: str,
                   elevation: float, quantity: str, log: bool | None):
+    import numpy as np
+
     from .. import models as _models
     from .. import plot as rbplot
 

@@ -31,7 +31,7 @@ def test_models_lists_every_model_with_units():
         assert name in res.output
         for p in rb.model(name).parameters:
             assert p.name in res.output
-    assert "[1/deg]" in res.output  # TS67 c is per degree (MODELS.md §2.3)
+    assert "[1/deg]" in res.output  # TS67 c is per degree (docs/models.md §2.3)
 
 
 def test_eval_tr75_matches_library():
@@ -48,7 +48,7 @@ def test_eval_tr75_matches_library():
                            math.radians(float(r["theta_r_deg"])),
                            math.radians(float(r["phi_deg"])))
         assert float(r["bridf"]) == pytest.approx(expected, rel=1e-9)
-    # MODELS.md §3.12 cement sample: beta = 45, elevation 45, TR75 psi = 180 (phi = 0): 0.1233
+    # docs/models.md §3.12 cement sample: beta = 45, elevation 45, TR75 psi = 180 (phi = 0): 0.1233
     one = [r for r in table if r["theta_r_deg"] == "45" and r["phi_deg"] == "0"][0]
     assert float(one["bridf"]) == pytest.approx(0.1233, abs=5e-5)
 

@@ -110,6 +110,30 @@ def test_plot_fit_writes_one_file_per_channel(tmp_path):
     _ok(["plot", "--fit", str(fit_dir), "--force"])
 
 
+def test_plot_fit_draws_through_the_fits_aperture(tmp_path, monkeypatch):
+    # a fit made with an instrument aperture is drawn the way it was compared with the data
+    import math
+
+    from roughbrdf import plot as rbplot
+
+    fit_dir = _fit_dir(tmp_path)
+    fit = json.loads((fit_dir / "fit.json").read_text())
+    fit["aperture"] = {"half_angle_rad": math.radians(2.0), "half_angle_deg": 2.0, "points": 7}
+    (fit_dir / "fit.json").write_text(json.dumps(fit))
+    seen = []
+    for name in ("plot_comparison", "plot_residual_map"):
+        real = getattr(rbplot, name)
+
+        def spy(*args, _real=real, **kw):
+            seen.append(kw.get("aperture"))
+            return _real(*args, **kw)
+
+        monkeypatch.setattr(rbplot, name, spy)
+    _ok(["plot", "--fit", str(fit_dir), "--channel", "465nm"])
+    assert len(seen) == 2
+    assert all(a.half_angle == pytest.approx(math.radians(2.0)) and a.points == 7 for a in seen)
+
+
 def test_plot_fit_one_channel_to_out_and_params_only(tmp_path):
     fit_dir = _fit_dir(tmp_path, spec=False)
     out = tmp_path / "cmp.png"

@@ -44,7 +44,7 @@ def test_demo_tables_match_models_md():
         row = next(r for r in t.splitlines() if r.split()[:1] == [str(psi)])
         left, right = row.split("|")
         vals = [float(v) for v in left.split()[-4:]]
-        assert vals[0] == pytest.approx(ref[1], abs=0.005)  # MODELS.md gives 3.19 for psi 75
+        assert vals[0] == pytest.approx(ref[1], abs=0.005)  # docs/models.md gives 3.19 for psi 75
         assert vals[1:] == pytest.approx(list(ref[2:]), abs=0.0011)
     t = demo.tr75_table1_dhr()
     for name, ref in demo.TR75_TABLE1.items():

@@ -3,9 +3,9 @@
 ``python -m roughbrdf.demo --out out``
 
 1. TS67 Fig. 8 (Eq. 23, F = 1, g = 2/3, c = 0.05/deg): the forward-peak table, computed with
-   ``rb.model("torrance-sparrow-1967").relative``, next to MODELS.md §2.7.
+   ``rb.model("torrance-sparrow-1967").relative``, next to docs/models.md §2.7.
 2. TR75 Table 1: directional-hemispherical reflectance at normal incidence of the six fitted
-   surfaces, computed with ``rb.albedo``, next to MODELS.md §3.10 and the paper's estimates.
+   surfaces, computed with ``rb.albedo``, next to docs/models.md §3.10 and the paper's estimates.
 3. The fitting job, the same as ``roughbrdf fit`` on a user file: the measurement embedded in the
    package (``roughbrdf/data/tr75_cement.csv``, a relative BRIDF of TR75's cement at TR75's own
    measurement design with 10 % noise; see ``roughbrdf/data/make_default.py``) is fitted with the
@@ -37,13 +37,13 @@ TRUE = {"e": 0.68, "n": 1.00, "k": 0.9, "rho_L": 0.33}
 #: neutral starting values (not the truth): the multistart also searches the whole bounds
 START = {"e": 0.3, "n": 1.5, "k": 0.1, "rho_L": 0.5}
 
-# MODELS.md §2.7, Fig. 8 (F = 1, g = 2/3, c = 0.05/deg): psi -> (theta_max, ratio at max,
+# docs/models.md §2.7, Fig. 8 (F = 1, g = 2/3, c = 0.05/deg): psi -> (theta_max, ratio at max,
 # ratio at theta = 0, at 89.99 deg, at -60 deg)
 TS67_FIG8 = {10: (13.3, 1.002, 0.970, 0.610, 0.627), 30: (43.0, 1.031, 0.762, 0.678, 0.533),
              45: (75.0, 1.318, 0.543, 0.979, 0.429), 60: (80.0, 1.904, 0.311, 1.819, 0.273),
              75: (90.0, 3.19, 0.095, 3.194, 0.091)}
 
-# MODELS.md §3.10, TR75 Table 1: name -> (e, n, k, rho_L, interface DHR, total DHR, paper)
+# docs/models.md §3.10, TR75 Table 1: name -> (e, n, k, rho_L, interface DHR, total DHR, paper)
 TR75_TABLE1 = {
     "3M Black Velvet (min 1)": (0.89, 1.60, 0.00, 0.020, 0.031, 0.051, "order of 4 %"),
     "3M Black Velvet (min 2)": (0.88, 1.62, 0.3, 0.022, 0.040, 0.062, "order of 4 %"),
@@ -60,13 +60,13 @@ def default_measurement_path() -> Path:
 
 
 def ts67_fig8_table() -> str:
-    """TS67 Fig. 8 forward-peak table, computed vs MODELS.md §2.7."""
+    """TS67 Fig. 8 forward-peak table, computed vs docs/models.md §2.7."""
     # TS67 has .relative (Eq. 23); rb.model is typed as returning the base Model
     ts = cast(Any, rb.model("torrance-sparrow-1967", g=2 / 3, c=0.05, n=None, k=None))
     theta = np.radians(np.append(np.arange(0.0, 89.99, 0.05), 89.99))
     lines = ["TS67 Fig. 8: relative reflectance, Eq. 23 (F = 1, g = 2/3, c = 0.05/deg), "
              "plane of incidence",
-             "  computed (this library) | MODELS.md §2.7",
+             "  computed (this library) | docs/models.md §2.7",
              f"  {'psi':>4} {'theta_max':>9} {'at max':>7} {'at 0':>6} {'at 89.99':>8} "
              f"{'at -60':>6} | {'theta_max':>9} {'at max':>7} {'at 0':>6} {'at 89.99':>8} "
              f"{'at -60':>6}"]
@@ -82,16 +82,16 @@ def ts67_fig8_table() -> str:
         lines.append(f"  {psi:>4} {tmax_s:>9} {r[i]:>7.3f} {r0:>6.3f} {r89:>8.3f} {rm60:>6.3f} | "
                      f"{ref[0]:>9.1f} {ref[1]:>7.3f} {ref[2]:>6.3f} {ref[3]:>8.3f} {ref[4]:>6.3f}")
     lines.append("  (psi = 75: the ratio keeps rising to grazing; max over theta <= 89.99 deg; "
-                 "MODELS.md rounds it to 3.19)")
+                 "docs/models.md rounds it to 3.19)")
     return "\n".join(lines)
 
 
 def tr75_table1_dhr() -> str:
-    """TR75 Table 1 surfaces: DHR at normal incidence (unpolarized) vs MODELS.md §3.10."""
+    """TR75 Table 1 surfaces: DHR at normal incidence (unpolarized) vs docs/models.md §3.10."""
     lines = ["TR75 Table 1: directional-hemispherical reflectance at normal incidence "
              "(rb.albedo, unpolarized)",
              f"  {'surface':<24} {'e':>5} {'n':>5} {'k':>4} {'rho_L':>6} | {'interface':>9} "
-             f"{'total':>6} | {'MODELS.md':>9} {'total':>6} | paper's estimate"]
+             f"{'total':>6} | {'models.md':>9} {'total':>6} | paper's estimate"]
     for name, (e, n, k, rho, ref_i, ref_t, paper) in TR75_TABLE1.items():
         m = rb.model("trowbridge-reitz-1975", e=e, n=n, k=k, rho_L=rho)
         total = float(rb.albedo(m, 0.0))
@@ -103,7 +103,7 @@ def tr75_table1_dhr() -> str:
     dhr = np.atleast_1d(rb.albedo(cement, np.radians(betas)))
     lines.append("  cement DHR vs incidence beta (no shadowing, rises with beta): "
                  + ", ".join(f"{b} deg {v:.3f}" for b, v in zip(betas, dhr, strict=True))
-                 + "  (MODELS.md: 0.450, 0.464, 0.548, 0.919)")
+                 + "  (docs/models.md: 0.450, 0.464, 0.548, 0.919)")
     return "\n".join(lines)
 
 

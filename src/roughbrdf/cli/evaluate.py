@@ -34,12 +34,14 @@ def register(app: typer.Typer) -> None:
             "--phi", help="azimuth (0 = forward), DEG or START:STOP:STEP")] = "0",
         polarization: Annotated[str, typer.Option(
             help="unpolarized, s, p or gamma in DEG")] = "unpolarized",
-        quantity: Annotated[str, typer.Option(help="brdf or bridf")] = "brdf",
+        quantity: Annotated[str, typer.Option(
+            help="brdf, brdf_cos (= bridf) or relative (to the specular value)")] = "brdf",
     ) -> None:
         """Evaluate a model on a grid of angles (degrees) and print CSV."""
         import numpy as np
 
         from .. import models as _models
+        from ..quantity import Quantity
 
         try:
             m = _models.model(model, **parse_params(param))
@@ -50,10 +52,9 @@ def register(app: typer.Typer) -> None:
                 pol: object = np.radians(float(polarization))
             except ValueError:
                 pol = polarization
-            if quantity not in ("brdf", "bridf"):
-                raise ValueError(f"--quantity must be brdf or bridf, got {quantity!r}")
+            q = Quantity.parse(quantity, "--quantity")
             TI, TR, PH = (a.reshape(-1) for a in np.meshgrid(ti, tr, ph, indexing="ij"))
-            f = getattr(m, quantity)(TI, TR, PH, polarization=pol)
+            f = m.evaluate(TI, TR, PH, quantity=q, polarization=pol)
         except ValueError as exc:
             typer.echo(f"error: {exc}", err=True)
             raise typer.Exit(2) from exc

@@ -74,6 +74,16 @@ def _fit_model(fit: dict[str, Any], chan: dict[str, Any]):
     return _models.model(str(name), **(chan.get("params") or {}))
 
 
+def _fit_aperture(fit: dict[str, Any]):
+    """The instrument aperture the fit used (``fit.json`` ``aperture``), or None."""
+    from ..instrument import Aperture
+
+    ap = fit.get("aperture")
+    if not isinstance(ap, dict):
+        return None
+    return Aperture.parse(ap["half_angle_rad"], ap.get("points", 19))
+
+
 def _fit_measurement(fit: dict[str, Any], base: Path):
     from dataclasses import replace
 
@@ -124,6 +134,7 @@ def _fit_figures(fit_dir: Path, out: Path | None, channel: str | None, force: bo
         target = out if out is not None else base / f"comparison_{_safe(c.get('channel'))}.png"
         _check_out(target, force)
         targets.append(target)
+    aperture = _fit_aperture(fit)
     written = []
     for c, target in zip(chans, targets, strict=True):
         model = _fit_model(fit, c)
@@ -132,8 +143,8 @@ def _fit_figures(fit_dir: Path, out: Path | None, channel: str | None, force: bo
         fig = Figure(figsize=(13, 5.2), layout="constrained")
         ax1 = fig.add_subplot(1, 2, 1)
         ax2 = fig.add_subplot(1, 2, 2)
-        rbplot.plot_comparison(model, meas, channel=ch, ax=ax1)
-        rbplot.plot_residual_map(model, meas, channel=ch, ax=ax2)
+        rbplot.plot_comparison(model, meas, channel=ch, ax=ax1, aperture=aperture)
+        rbplot.plot_residual_map(model, meas, channel=ch, ax=ax2, aperture=aperture)
         fig.suptitle(f"fit {fit_dir}: {fit['model']} to {Path(str(fit['file'])).name} "
                      f"[{label}], loss {fit.get('loss', '?')}", fontsize="medium")
         fig.savefig(target, dpi=100)

@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from ..interrupts import held_interrupts
+
 __all__ = ["as_float_array", "broadcast_dense", "broadcast_strided", "evaluate"]
 
 
@@ -68,9 +70,11 @@ def evaluate(
     out = np.empty((n, *out_shape), dtype=np.float64)
     if n:
         p = tuple(float(v) for v in params)
-        drive(broadcast_dense(theta_i, shape), broadcast_dense(theta_r, shape),
-              broadcast_dense(phi, shape), broadcast_dense(gamma, shape), p, int(flag),
-              out if out_shape else out.reshape(n))
+        args = (broadcast_dense(theta_i, shape), broadcast_dense(theta_r, shape),
+                broadcast_dense(phi, shape), broadcast_dense(gamma, shape), p, int(flag),
+                out if out_shape else out.reshape(n))
+        with held_interrupts():  # Ctrl-C while a kernel loads would be lost (interrupts.py)
+            drive(*args)
     if not shape and not out_shape:
         return float(out[0])
     return out.reshape(*shape, *out_shape)

@@ -39,6 +39,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
+from ..interrupts import held_interrupts
 from .cache import install_cache_locators
 
 __all__ = ["DISABLE_JIT", "LazyUfunc", "jit", "ufunc", "driver", "at"]
@@ -92,7 +93,8 @@ class LazyUfunc:
     def _build(self) -> Any:
         if self._ufunc is None:
             sig = "f8(" + ",".join(["f8"] * self._nargs) + ")"
-            self._ufunc = numba.vectorize([sig], cache=True)(self._fn)
+            with held_interrupts():  # Ctrl-C while it loads would be lost (interrupts.py)
+                self._ufunc = numba.vectorize([sig], cache=True)(self._fn)
         return self._ufunc
 
     @property

@@ -56,6 +56,7 @@ from .. import _kernels, special
 from .. import shadowing as shd
 from .._kernels import at, driver, jit, sincos
 from ..fresnel import check_index, fresnel_sp
+from ..interrupts import held_interrupts
 from ..registry import Registry
 from .base import Model, PreparedGeometry, register
 from .parameters import Parameter, nonnegative, positive
@@ -312,14 +313,17 @@ def _run(ti, tr, phi, gamma, p: tuple, flag: int, ns=None, nr=None):
             lean = p[_WA] == 0.0 and p[_SAME_V] == 1.0
             drive = _rb08_fast_lean if lean else _rb08_fast
             a = float(ti.reshape(-1)[0]) if ti.size == 1 else _dense_array(ti, shape)
-            drive(a, _dense_array(tr, shape), _dense_array(phi, shape),
-                  float(gamma.reshape(-1)[0]), pt, int(flag), out)
+            with held_interrupts():  # Ctrl-C while a kernel loads would be lost
+                drive(a, _dense_array(tr, shape), _dense_array(phi, shape),
+                      float(gamma.reshape(-1)[0]), pt, int(flag), out)
         else:
             flat = _kernels.broadcast_strided
             nan = np.full(1, math.nan)
-            _rb08_general(*flat(ti, shape), *flat(tr, shape), *flat(phi, shape),
-                          *flat(gamma, shape), *((nan, 0) if ns is None else flat(ns, shape)),
-                          *((nan, 0) if nr is None else flat(nr, shape)), pt, int(flag), out)
+            args = (*flat(ti, shape), *flat(tr, shape), *flat(phi, shape), *flat(gamma, shape),
+                    *((nan, 0) if ns is None else flat(ns, shape)),
+                    *((nan, 0) if nr is None else flat(nr, shape)), pt, int(flag), out)
+            with held_interrupts():
+                _rb08_general(*args)
     if not shape:
         return float(out[0])
     return out.reshape(shape)

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..interrupts import held_interrupts
 
-__all__ = ["as_float_array", "broadcast_dense", "broadcast_strided", "evaluate"]
+__all__ = ["as_float_array", "broadcast_array", "broadcast_dense", "broadcast_strided", "evaluate"]
 
 
 def as_float_array(x: Any, name: str) -> np.ndarray:
@@ -32,6 +32,13 @@ def broadcast_dense(arr: np.ndarray, shape: tuple[int, ...]) -> np.ndarray | flo
     """A float if ``arr`` has one element, else a contiguous 1-D array of the broadcast shape."""
     if arr.size == 1:
         return float(arr.reshape(-1)[0])
+    if arr.shape == shape and arr.flags.c_contiguous:
+        return arr.reshape(-1)
+    return np.ascontiguousarray(np.broadcast_to(arr, shape)).reshape(-1)
+
+
+def broadcast_array(arr: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    """A contiguous 1-D array of ``arr`` broadcast to ``shape`` (a view when it already is one)."""
     if arr.shape == shape and arr.flags.c_contiguous:
         return arr.reshape(-1)
     return np.ascontiguousarray(np.broadcast_to(arr, shape)).reshape(-1)
@@ -70,8 +77,11 @@ def evaluate(
     out = np.empty((n, *out_shape), dtype=np.float64)
     if n:
         p = tuple(float(v) for v in params)
-        args = (broadcast_dense(theta_i, shape), broadcast_dense(theta_r, shape),
-                broadcast_dense(phi, shape), broadcast_dense(gamma, shape), p, int(flag),
+        # the angles always as arrays, gamma as a float when it is one value: two compiled
+        # variants per driver (a float angle would add up to eight more, some of which take
+        # LLVM minutes to optimize, and buys nothing where it matters: large arrays)
+        args = (broadcast_array(theta_i, shape), broadcast_array(theta_r, shape),
+                broadcast_array(phi, shape), broadcast_dense(gamma, shape), p, int(flag),
                 out if out_shape else out.reshape(n))
         with held_interrupts():  # Ctrl-C while a kernel loads would be lost (interrupts.py)
             drive(*args)

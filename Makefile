@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml
 venv: $(STAMP)
 
 demo: $(STAMP)
-	$(PY) -m roughbrdf.demo --out out
+	$(PY) -m roughbrdf.demo --out out --force
 
 # the suite (tests/), every docstring example in src/ and the README's examples (pyproject.toml)
 test: $(STAMP)

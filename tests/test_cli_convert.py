@@ -104,3 +104,50 @@ def test_errors(tmp_path, args, match):
     res = _run(*[a.format(d=tmp_path) for a in args])
     assert res.exit_code == 2
     assert match in res.output.replace("\n", " ") or match in res.output
+
+
+def test_out_is_a_folder_or_in_itself(tmp_path):
+    """Why: a folder given as OUT ended in an OSError traceback after the work was done."""
+    src = tmp_path / "in.csv"
+    src.write_text(CSV)
+    folder = tmp_path / "outdir"
+    folder.mkdir()
+    res = _run(src, folder)
+    assert res.exit_code == 3 and "is a folder" in res.output
+    assert "Traceback" not in res.output and list(folder.iterdir()) == []
+    res = _run(src, src, "--force")
+    assert res.exit_code == 2 and "same file" in res.output
+    assert src.read_text() == CSV
+
+
+def test_options_that_contradict_the_file_are_refused(tmp_path):
+    src = tmp_path / "in.csv"
+    src.write_text(CSV)
+    res = _run(src, tmp_path / "o.dat", "--quantity", "brdf_cos")
+    assert res.exit_code == 2
+    assert "--quantity brdf_cos" in res.output and "contradicts" in res.output
+    res = _run(src, tmp_path / "o.dat", "--angles-in", "rad")
+    assert res.exit_code == 2 and "--angles-in rad" in res.output
+    assert not (tmp_path / "o.dat").exists()
+
+
+def test_os_error_is_one_line_with_exit_3(tmp_path, monkeypatch):
+    """A full disk (or any OS error while writing): one line naming OUT and the cause, exit 3,
+    no traceback, no file."""
+    import errno
+
+    import roughbrdf.output
+
+    src = tmp_path / "in.csv"
+    src.write_text(CSV)
+
+    def full(fd):
+        raise OSError(errno.ENOSPC, "No space left on device", "/somewhere/.roughbrdf-tmp-x")
+
+    monkeypatch.setattr(roughbrdf.output.os, "fsync", full)
+    out = tmp_path / "o.csv"
+    res = _run(src, out)
+    assert res.exit_code == 3
+    assert f"cannot write {out}: No space left on device" in res.output
+    assert "Traceback" not in res.output and not out.exists()
+    assert [p.name for p in tmp_path.iterdir()] == ["in.csv"]

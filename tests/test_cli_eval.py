@@ -88,22 +88,25 @@ def test_eval_horizon_gives_inf_for_unshadowed_tr75():
     assert rows(res.stdout)[0]["brdf"] == "inf"
 
 
-@pytest.mark.parametrize("args, needle", [
-    (["eval", "trowbridge-reits"], "did you mean 'trowbridge-reitz-1975'"),
-    (["eval", "tr75", "-p", "bogus=1"], "unknown parameter"),
-    (["eval", "tr75", "-p", "e=-1"], "'e' = -1.0"),
-    (["eval", "tr75", "-p", "k=-0.5"], "'k' = -0.5"),
-    (["eval", "ts67", "-p", "c=0"], "'c' = 0.0"),
-    (["eval", "tr75", "--theta-i", "90"], "theta_i"),
-    (["eval", "tr75", "--theta-r", "95"], "theta_r"),
-    (["eval", "microfacet", "-p", "distribution=bekmann"], "did you mean 'beckmann'"),
-    (["eval", "tr75", "--quantity", "radiance"], "--quantity"),
-    (["eval", "tr75", "--polarization", "q"], "polarization"),
+@pytest.mark.parametrize("args, needles", [
+    (["eval", "trowbridge-reits"], ["did you mean 'trowbridge-reitz-1975'"]),
+    (["eval", "tr75", "-p", "bogus=1"], ["unknown parameter"]),
+    (["eval", "tr75", "-p", "e=-1"], ["'e'", "-1.0"]),
+    (["eval", "tr75", "-p", "k=-0.5"], ["'k'", "-0.5"]),
+    (["eval", "ts67", "-p", "c=0"], ["'c'", "0.0"]),
+    # angles are named as the options and shown in degrees (issue 9, part 7)
+    (["eval", "tr75", "--theta-i", "90"], ["--theta-i 90 (degrees)"]),
+    (["eval", "tr75", "--theta-r", "95"], ["--theta-r 95 (degrees)"]),
+    (["eval", "microfacet", "-p", "distribution=bekmann"], ["did you mean 'beckmann'"]),
+    (["eval", "tr75", "--quantity", "radiance"], ["--quantity"]),
+    (["eval", "tr75", "--polarization", "q"], ["polarization"]),
 ])
-def test_eval_errors(args, needle):
+def test_eval_errors(args, needles):
     res = run(*args)
     assert res.exit_code == 2
-    assert needle in res.output
+    for needle in needles:
+        assert needle in res.output
+    assert len(res.output.strip().splitlines()) == 1  # one line, no traceback
 
 
 @pytest.mark.parametrize("bad", ["a:b", "0:90", "0:90:0", "50:10:5"])
@@ -111,3 +114,23 @@ def test_eval_bad_ranges(bad):
     res = run("eval", "tr75", "--theta-r", bad)
     assert res.exit_code == 2
     assert "--theta-r" in res.output
+
+
+def test_models_lists_aliases():
+    res = run("models")
+    assert res.exit_code == 0, res.output
+    assert "  aliases: tr75, trowbridge-reitz" in res.output
+    assert "  aliases: ts67, torrance-sparrow" in res.output
+    for name in rb.available():
+        block = res.output.split(name + "  (", 1)[1].split("\n\n", 1)[0]
+        for alias in type(rb.model(name)).aliases:
+            assert alias in block
+
+
+@pytest.mark.parametrize("spelling", ["BRDF_COS", "brdf-cos", "brdf*cos", "bridf"])
+def test_eval_quantity_spellings(spelling):
+    res = run("eval", "tr75", "--theta-i", "30", "--theta-r", "40", "--quantity", spelling)
+    assert res.exit_code == 0, res.output
+    (r,) = rows(res.stdout)
+    assert float(r[spelling]) == pytest.approx(
+        rb.model("tr75").bridf(math.radians(30), math.radians(40), 0.0), rel=1e-9)

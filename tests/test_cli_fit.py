@@ -120,9 +120,18 @@ def test_never_overwrites_foreign_files(tmp_path):
     res = _fit(*args)
     assert res.exit_code == 2 and "not overwriting fit.json" in res.output
     assert (out / "fit.json").read_text() == "{}"
+    # issue 9: a file roughbrdf did not write is never replaced, not even with --force
     res = _fit(*args, "--force")
+    assert res.exit_code == 2 and "not overwriting fit.json" in res.output
+    assert "not even with --force" in res.output
+    assert (out / "fit.json").read_text() == "{}"
+    (out / "fit.json").unlink()  # the user moves it away
+    res = _fit(*args)
     assert res.exit_code == 0, res.output
-    res = _fit(*args)  # now the files are ours: a second run replaces them
+    res = _fit(*args)  # the folder holds results now: a second run asks for --force
+    assert res.exit_code == 2 and "holds results already" in res.output
+    assert "--force" in res.output and "overwrite=True" not in res.output
+    res = _fit(*args, "--force")  # and replaces them with it
     assert res.exit_code == 0, res.output
     assert (out / "notes.txt").read_text() == "keep"
     assert json.loads((out / "fit.json").read_text())["model"] == "trowbridge-reitz-1975"
@@ -178,3 +187,120 @@ def test_free_scale_option_fits_a_data_scale_on_absolute_data(tmp_path):
     ch = json.loads((tmp_path / "fixed" / "fit.json").read_text())["channels"][0]
     assert ch["scale"] == 1.0
     assert not list(tmp_path.glob("*/*.png"))
+
+
+# ---------------------------------------------------------------------------------------------
+# issue 9: CLI options for what the library takes (part 7), refusing before the fit (part 1)
+# ---------------------------------------------------------------------------------------------
+def test_bounds_option(tmp_path):
+    out = tmp_path / "b"
+    res = _fit(DEFAULT, "-m", "tr75", "--bounds", "e=0.1:0.5", "--bounds", "rho_L=0.2:0.6",
+               "--starts", "2", "--no-plots", "-q", "--out", out)
+    assert res.exit_code == 0, res.output
+    params = json.loads((out / "fit.json").read_text())["channels"][0]["params"]
+    assert 0.1 <= params["e"] <= 0.5 and params["e"] == pytest.approx(0.5, abs=1e-6)  # true 0.68
+    m = build_model("trowbridge-reitz-1975+lambertian")
+    from roughbrdf.cli.fit import parse_bounds
+
+    assert parse_bounds(m, ["e=0:1", "rho=0.1:0.2"]) == {"tr75_e": (0.0, 1.0),
+                                                          "lambertian_rho": (0.1, 0.2)}
+
+
+@pytest.mark.parametrize("bounds, needle", [
+    ("e=0.1", "--bounds expects NAME=LOW:HIGH"),
+    ("e:0.1:2", "--bounds expects NAME=LOW:HIGH"),
+    ("e=a:b", "--bounds expects NAME=LOW:HIGH"),
+    ("e=2:1", "need finite LOW < HIGH"),
+    ("bogus=0:1", "unknown parameter 'bogus'"),
+    ("e=1:2", "--bounds"),  # the starting value -p e=0.68 is outside: the fix names the option
+])
+def test_bounds_errors_name_the_option(tmp_path, bounds, needle):
+    res = _fit(DEFAULT, "-m", "tr75", "-p", "e=0.68", "--bounds", bounds, "--out",
+               tmp_path / "x", "--no-plots")
+    assert res.exit_code == 2, res.output
+    assert needle in res.output and "bounds={" not in res.output
+    assert not (tmp_path / "x").exists()
+
+
+def test_angles_in_option(tmp_path):
+    text = DEFAULT.read_text().replace("# angles: deg\n", "")
+    path = tmp_path / "noangles.csv"
+    path.write_text(text)
+    res = _fit(path, "-m", "tr75", "--starts", "1", "--no-plots", "-q", "--out", tmp_path / "a")
+    assert res.exit_code == 2 and "angle" in res.output  # the reader's message (roughbrdf.io)
+    res = _fit(path, "-m", "tr75", "--angles-in", "deg", "--starts", "1", "--no-plots", "-q",
+               "--out", tmp_path / "a")
+    assert res.exit_code == 0, res.output
+    d = json.loads((tmp_path / "a" / "fit.json").read_text())
+    assert d["channels"][0]["params"]["e"] == pytest.approx(0.68, abs=0.05)
+    res = _fit(path, "-m", "tr75", "--angles-in", "grad", "--out", tmp_path / "b")
+    assert res.exit_code == 2 and "--angles-in must be deg or rad, got 'grad'" in res.output
+    alta = tmp_path / "x.dat"
+    alta.write_text("#DIM 3 1\n#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI\n#PARAM_OUT INV_STERADIAN\n"
+                    "0.1 0.2 0 1\n")
+    res = _fit(alta, "-m", "tr75", "--angles-in", "deg", "--out", tmp_path / "b")
+    assert res.exit_code == 2 and "--angles-in applies to ASTM and CSV files" in res.output
+
+
+def test_quantity_takes_every_spelling(tmp_path, monkeypatch):
+    from roughbrdf import io as rbio
+
+    seen = []
+    real = rbio.read
+
+    def spy(path, format=None, **options):
+        seen.append(options.get("quantity"))
+        return real(path, format=format, **options)
+
+    monkeypatch.setattr(rbio, "read", spy)
+    for spelling in ("RELATIVE", "relative"):
+        res = _fit(DEFAULT, "-m", "tr75", "--quantity", spelling, "--starts", "1", "-q",
+                   "--no-plots", "--out", tmp_path / spelling)
+        assert res.exit_code == 0, res.output
+    assert seen == ["relative", "relative"]
+    res = _fit(DEFAULT, "-m", "tr75", "--quantity", "radiance", "--out", tmp_path / "x")
+    assert res.exit_code == 2
+    assert "--quantity must be one of brdf, brdf_cos, bridf, relative" in res.output
+
+
+def test_refuses_before_fitting(tmp_path, monkeypatch):
+    import roughbrdf.fitting
+
+    def must_not_fit(*args, **kwargs):
+        raise AssertionError("fitted")
+
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "fit_relative.png").write_bytes(b"the user's figure")
+    monkeypatch.setattr(roughbrdf.fitting, "fit", must_not_fit)
+    res = _fit(DEFAULT, "-m", "tr75", "--out", out)
+    assert res.exit_code == 2 and "not overwriting fit_relative.png" in res.output
+    assert (out / "fit_relative.png").read_bytes() == b"the user's figure"
+
+
+def test_result_names_are_the_names_save_writes(tmp_path):
+    from roughbrdf.cli.fit import result_names
+
+    meas = rb.read(DEFAULT)
+    res = rb.fit(rb.model("tr75"), meas, starts=1)
+    assert result_names(meas, None, True) == ["fit.json", "report.txt", *res.plot_names()]
+    assert result_names(meas, ["0"], False) == ["fit.json", "report.txt"]
+
+
+def test_force_replaces_the_whole_earlier_set(tmp_path):
+    """issue 9: a second fit (another model, no plots) replaced fit.json and report.txt without a
+    word and left the old PNG beside them; now it asks for --force, which replaces the set."""
+    out = tmp_path / "o"
+    res = _fit(DEFAULT, "-m", "tr75", "--starts", "1", "-q", "--out", out)
+    assert res.exit_code == 0, res.output
+    assert (out / "fit_relative.png").is_file()
+    again = (DEFAULT, "-m", "ts67", "-p", "n=None", "--fix", "rho_d", "--starts", "1", "-q",
+             "--no-plots", "--out", out)
+    res = _fit(*again)
+    assert res.exit_code == 2 and "holds results already" in res.output
+    assert json.loads((out / "fit.json").read_text())["model"] == "trowbridge-reitz-1975"
+    res = _fit(*again, "--force")
+    assert res.exit_code == 0, res.output
+    assert sorted(p.name for p in out.iterdir()) == [".roughbrdf-outputs", "fit.json",
+                                                     "report.txt"]
+    assert json.loads((out / "fit.json").read_text())["model"] == "torrance-sparrow-1967"

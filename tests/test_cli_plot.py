@@ -161,3 +161,78 @@ def test_plot_fit_errors(tmp_path):
     assert res.exit_code == 2 and "gone.csv" in res.output
     res = runner.invoke(app, ["plot", "lambertian", "--fit", str(tmp_path)])
     assert res.exit_code == 2 and "not both" in res.output
+
+
+# ---------------------------------------------------------------------------------------------
+# issue 9: --fit DIR from any folder, a changed input, the fit's set (parts 1, 7)
+# ---------------------------------------------------------------------------------------------
+def _sha(path) -> str:
+    import hashlib
+
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _record_input(fit_dir, **keys):
+    fit = json.loads((fit_dir / "fit.json").read_text())
+    fit.update(keys)
+    (fit_dir / "fit.json").write_text(json.dumps(fit))
+
+
+def test_plot_fit_from_any_folder(tmp_path, monkeypatch):
+    fit_dir = _fit_dir(tmp_path)
+    data = tmp_path / "data.csv"
+    # as `roughbrdf fit data.csv` run in tmp_path records it
+    _record_input(fit_dir, file="data.csv", file_abspath=str(data), file_sha256=_sha(data))
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    res = _ok(["plot", "--fit", str(fit_dir), "--channel", "465nm"])
+    assert "warning" not in res.output
+    assert (fit_dir / "comparison_465nm.png").read_bytes()[:8] == PNG
+    # a different data.csv in the current folder: the recorded one (same SHA-256) wins
+    (elsewhere / "data.csv").write_text(data.read_text().replace("465nm", "465nm "))
+    res = _ok(["plot", "--fit", str(fit_dir), "--channel", "630nm"])
+    assert "warning" not in res.output
+
+
+def test_plot_fit_warns_when_the_input_changed(tmp_path):
+    fit_dir = _fit_dir(tmp_path)
+    data = tmp_path / "data.csv"
+    _record_input(fit_dir, file_abspath=str(data), file_sha256="0" * 64)
+    res = _ok(["plot", "--fit", str(fit_dir), "--channel", "465nm"])
+    lines = [ln for ln in res.stderr.splitlines() if ln.startswith("warning")]
+    assert len(lines) == 1 and str(data) in lines[0] and "changed since the fit" in lines[0]
+    _record_input(fit_dir, file_sha256=_sha(data))
+    res = _ok(["plot", "--fit", str(fit_dir), "--channel", "630nm"])
+    assert "warning" not in res.output
+
+
+def test_plot_fit_adds_its_figures_to_the_fits_results(tmp_path):
+    from roughbrdf.output import MANIFEST
+
+    fit_dir = _fit_dir(tmp_path)
+    (fit_dir / MANIFEST).write_text(json.dumps(["fit.json"]))
+    _ok(["plot", "--fit", str(fit_dir)])
+    assert json.loads((fit_dir / MANIFEST).read_text()) == [
+        "comparison_465nm.png", "comparison_630nm.png", "fit.json"]
+    # a figure the user made under that name is never replaced, not even with --force
+    (fit_dir / "comparison_465nm.png").unlink()
+    (fit_dir / MANIFEST).write_text(json.dumps(["comparison_630nm.png", "fit.json"]))
+    (fit_dir / "comparison_465nm.png").write_bytes(b"mine")
+    res = runner.invoke(app, ["plot", "--fit", str(fit_dir), "--force"])
+    assert res.exit_code == 2 and "not overwriting comparison_465nm.png" in res.output
+    assert (fit_dir / "comparison_465nm.png").read_bytes() == b"mine"
+
+
+@pytest.mark.parametrize("spelling", ["BRDF", "brdf-cos", "brdf*cos", "bridf", "Relative"])
+def test_plot_quantity_takes_every_spelling(tmp_path, spelling):
+    out = tmp_path / "sub" / "q.png"  # the folder is created
+    _ok(["plot", "lambertian", "--quantity", spelling, "--theta-i", "30", "--out", str(out)])
+    assert out.read_bytes()[:8] == PNG
+
+
+def test_plot_errors_name_options_in_degrees(tmp_path):
+    res = runner.invoke(app, ["plot", "tr75", "--kind", "hemisphere", "--theta-i", "95",
+                              "--out", str(tmp_path / "x.png")])
+    assert res.exit_code == 2 and "--theta-i 95 (degrees)" in res.output
+    assert not (tmp_path / "x.png").exists()

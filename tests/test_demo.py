@@ -4,6 +4,8 @@ default measurement, with its files in the output folder."""
 from __future__ import annotations
 
 import json
+import sys
+from pathlib import Path
 
 import pytest
 
@@ -35,7 +37,7 @@ def test_demo_prints_tables_and_recovers_cement(tmp_path, capsys):
         assert abs(ch["params"][name] - truth) <= 3 * ch["stderr"][name], name
     assert ch["metrics"]["sigma"] == pytest.approx(0.10, abs=0.02)  # the 10 % noise
     # a second run into the same folder replaces its own files
-    assert demo.main(["--out", str(out)]) == 0
+    assert demo.main(["--out", str(out), "--force"]) == 0
 
 
 def test_demo_tables_match_models_md():
@@ -59,3 +61,27 @@ def test_demo_refuses_foreign_files(tmp_path):
     with pytest.raises(FileExistsError, match="not overwriting report.txt"):
         demo.main(["--out", str(tmp_path)])
     assert (tmp_path / "report.txt").read_text() == "mine"
+
+
+def test_demo_refuses_earlier_results_before_any_work(tmp_path, monkeypatch, capsys):
+    """issue 9: `make demo` passes --force for its own out/; without it an earlier result stops
+    the run before it computes anything, with one line and exit status 2."""
+    from roughbrdf.output import ResultFolder
+
+    with ResultFolder(tmp_path) as out:
+        out.add("fit.json", "{}")
+
+    def must_not_run():
+        raise AssertionError("computed")
+
+    monkeypatch.setattr(demo, "ts67_fig8_table", must_not_run)
+    monkeypatch.setattr(sys, "argv", ["python -m roughbrdf.demo", "--out", str(tmp_path)])
+    assert demo._console() == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {tmp_path} holds results already (fit.json)")
+    assert "--force" in err and len(err.strip().splitlines()) == 1
+
+
+def test_make_demo_passes_force():
+    makefile = (Path(__file__).parents[1] / "Makefile").read_text()
+    assert "$(PY) -m roughbrdf.demo --out out --force" in makefile

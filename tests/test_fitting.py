@@ -416,15 +416,21 @@ def test_plot_and_save(two_channel_fit, tmp_path):
     written = two_channel_fit.save(tmp_path / "out")
     names = sorted(p.name for p in written)
     assert names == ["fit.json", "fit_blue.png", "fit_red.png", "report.txt"]
-    two_channel_fit.save(tmp_path / "out", plots=False)  # our own files: replaced
+    # an earlier run's results are replaced only when asked (issue 9, part 1); the new set
+    # replaces the old one exactly (the stale PNGs go)
+    two_channel_fit.save(tmp_path / "out", plots=False, overwrite=True)
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()
+                  if not p.name.startswith(".")) == ["fit.json", "report.txt"]
     (tmp_path / "mine").mkdir()
     (tmp_path / "mine" / "report.txt").write_text("my notes")
-    with pytest.raises(FileExistsError, match="not overwriting report.txt"):
+    with pytest.raises(FileExistsError, match="report.txt"):
         two_channel_fit.save(tmp_path / "mine", plots=False)
     assert (tmp_path / "mine" / "report.txt").read_text() == "my notes"
     assert not (tmp_path / "mine" / "fit.json").exists()  # nothing written before the check
-    two_channel_fit.save(tmp_path / "mine", plots=False, force=True)
-    assert (tmp_path / "mine" / "report.txt").read_text().startswith("[[Fit]]")
+    # a file roughbrdf did not write is never replaced, not even with overwrite=True
+    with pytest.raises(FileExistsError, match=r"report\.txt.*not written by roughbrdf"):
+        two_channel_fit.save(tmp_path / "mine", plots=False, overwrite=True)
+    assert (tmp_path / "mine" / "report.txt").read_text() == "my notes"
 
 
 def test_relative_plot_data_on_model_scale():

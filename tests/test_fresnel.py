@@ -39,8 +39,10 @@ def tr75_eq20_21(s: float, n: float, k: float) -> tuple[float, float]:
     a = n * sin_s / m2
     b = k * sin_s / m2
     c = 1 - sin_s**2 / m2
-    if k == 0 and c <= 0:  # beyond the critical angle: sin s1 = 1 exactly, and Eq. 20-21 give 1
-        return 1.0, 1.0  # (evaluating asin at a rounded 1 - 1e-16 would lose 8 digits)
+    if c <= 0 and 2 * b <= 1e-12 * -c:  # beyond the critical angle with no (or negligible,
+        # e.g. k = 1e-187) absorption: sin s1 = 1 to rounding, and Eq. 20-21 give 1 to 1e-12
+        # (evaluating asin at a rounded 1 - 1e-16 would lose 8 digits)
+        return 1.0, 1.0
     root = math.sqrt(c * c + 4 * b * b)
     # (root - c)/2, written without cancellation when c > 0 (small s, where root ~ c)
     sinh2 = 2 * b * b / (root + c) if c > 0 else (root - c) / 2

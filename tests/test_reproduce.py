@@ -301,7 +301,7 @@ def test_files_are_written(ts, tr, tmp_path):
                 assert "," in header
         with pytest.raises(FileExistsError):
             rep.write(tmp_path)
-    small = ts["ts67_fig07"].write(tmp_path, force=True, compact=True)
+    small = ts["ts67_fig07"].write(tmp_path, overwrite=True, compact=True)
     assert small[0].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
@@ -325,6 +325,44 @@ def test_run_and_cli(tmp_path):
     res = runner.invoke(app, ["reproduce", "--paper", "rb08", "--out", str(tmp_path / "r2"),
                               "--data", str(tmp_path / "nowhere")])
     assert res.exit_code == 2 and "gray tape" in res.output
+
+
+def _fake(name, value):
+    from roughbrdf.reproduce import Reproduction, Table
+
+    return Reproduction(name=name, title=name, tables={"t": Table(["x"], [[value]])})
+
+
+def test_run_writes_one_set_and_replaces_it_only_with_overwrite(tmp_path, monkeypatch):
+    """issue 9: the folder holds one run's results; a failure midway leaves them as they were."""
+    import roughbrdf.reproduce as rp
+    from roughbrdf.output import MANIFEST, OverwriteRefused
+
+    monkeypatch.setattr(rp, "reproductions", lambda *a, **k: iter([_fake("a", 1), _fake("b", 2)]))
+    out = tmp_path / "rep"
+    assert [p.name for p in run("all", out)] == ["a.csv", "b.csv"]
+    (out / "notes.md").write_text("the user's")
+
+    def computing(*a, **k):
+        raise AssertionError("refused before computing")
+
+    monkeypatch.setattr(rp, "reproductions", computing)
+    with pytest.raises(OverwriteRefused, match=r"holds results already \(a.csv, b.csv\)"):
+        run("all", out)
+
+    def fails_midway(*a, **k):
+        yield _fake("a", 10)
+        raise RuntimeError("the second reproduction fails")
+
+    monkeypatch.setattr(rp, "reproductions", fails_midway)
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    with pytest.raises(RuntimeError):
+        run("all", out, overwrite=True)
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    monkeypatch.setattr(rp, "reproductions", lambda *a, **k: iter([_fake("a", 3)]))
+    run("all", out, overwrite=True)
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "a.csv", "notes.md"]  # b went
+    assert (out / "a.csv").read_text() == "x\n3\n"
 
 
 # ---------------------------------------------------------------------------------------------

@@ -12,8 +12,12 @@
    TR75 model from a neutral start; the recovered parameters are printed next to the true ones,
    with TR75's sigma, and ``fit.json``, ``report.txt`` and the plot are written to ``--out``.
 
-The output folder may exist; files roughbrdf did not write are never overwritten (see
-:mod:`roughbrdf._outdir`).
+Everything goes into ``--out`` as one set (:class:`roughbrdf.output.ResultFolder`): a folder
+that holds results already is refused before any work unless ``--force`` (``make demo`` passes
+it for its own ``out/``), files roughbrdf did not write are never replaced, and an error or
+Ctrl-C leaves the folder as it was. Exit status as ``roughbrdf`` (:mod:`roughbrdf.cli`): 0, 1 if
+the fit did not converge, 2 refused or bad input, 3 an error of the operating system, 130
+interrupted.
 """
 
 from __future__ import annotations
@@ -29,7 +33,7 @@ import numpy as np
 
 import roughbrdf as rb
 
-from ._outdir import OutputDir
+from .output import ResultFolder
 
 #: the embedded default measurement and the parameters it was generated from
 DEFAULT_FILE = "tr75_cement.csv"
@@ -125,37 +129,78 @@ def recovered_table(res: rb.FitResult) -> str:
     return "\n".join(lines)
 
 
+#: the files of the demo, all in one folder
+TABLE_FILES = ("ts67_fig8.txt", "tr75_table1_dhr.txt", "recovered.txt")
+
+
+def fit_files(res: rb.FitResult, dpi: int = 110) -> dict[str, Any]:
+    """``fit.json``, ``report.txt`` and the plots of ``res``, as :meth:`rb.FitResult.save`
+    writes them, for a :class:`~roughbrdf.output.ResultFolder` shared with the tables."""
+    files: dict[str, Any] = {"fit.json": res.to_json() + "\n", "report.txt": res.report() + "\n"}
+    for i, name in enumerate(res.plot_names()):
+        fig, _ = res.plot(i)
+        files[name] = (lambda fh, fig=fig: fig.savefig(fh, format="png", dpi=dpi,
+                                                       metadata={"Software": "roughbrdf"}))
+    return files
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Run the demo; returns the exit status (0, or 1 if the fit did not converge)."""
     ap = argparse.ArgumentParser(prog="python -m roughbrdf.demo",
                                  description=__doc__.split("\n")[0])
     ap.add_argument("--out", default="out", help="output folder (default: out)")
     ap.add_argument("--starts", type=int, default=8, help="multistart points (default 8)")
     ap.add_argument("--force", action="store_true",
-                    help="overwrite files of the same name that roughbrdf did not write")
+                    help="replace the results of an earlier run in --out (files roughbrdf did "
+                         "not write are never replaced)")
     args = ap.parse_args(argv)
-    out = OutputDir(args.out, force=args.force)
-    fit_files = ["fit.json", "report.txt", "fit_relative.png"]
-    out.check(["ts67_fig8.txt", "tr75_table1_dhr.txt", "recovered.txt", *fit_files])
+    out = ResultFolder(args.out, overwrite=args.force)
+    out.check([*TABLE_FILES, "fit.json", "report.txt", "fit_relative.png"])  # before any work
 
     t1 = ts67_fig8_table()
     print(t1, end="\n\n", flush=True)
-    out.write_text("ts67_fig8.txt", t1)
     t2 = tr75_table1_dhr()
     print(t2, end="\n\n", flush=True)
-    out.write_text("tr75_table1_dhr.txt", t2)
 
     path = default_measurement_path()
     meas = rb.read(path)
     print(f"Fitting the embedded default measurement: {meas.summary()}", flush=True)
     res = rb.fit(rb.model("trowbridge-reitz-1975", **START), meas, starts=args.starts)
-    written = res.save(out.path, force=args.force)
     print(res.report(), end="\n\n")
     t3 = "Recovered vs true (TR75 Table 1, cement):\n" + recovered_table(res)
     print(t3)
-    out.write_text("recovered.txt", t3)
-    print(f"\nwrote {', '.join(str(p) for p in written)} and the tables into {out.path}/")
+    with out:
+        for name, text in zip(TABLE_FILES, (t1, t2, t3), strict=True):
+            out.add(name, text + "\n")
+        for name, content in fit_files(res).items():
+            out.add(name, content, binary=callable(content))
+    print(f"\nwrote {', '.join(sorted(out.previous()))} into {out.path}/")
     return 0 if res.success else 1
 
 
+def _console() -> int:
+    """``python -m roughbrdf.demo``: :func:`main` with the errors and Ctrl-C of the CLI (one
+    line on stderr, the exit statuses of :mod:`roughbrdf.cli`; a bug keeps its traceback)."""
+    from .cli import EXIT_BUG, EXIT_INTERRUPTED
+    from .cli.common import error_message, exit_status
+    from .interrupts import interrupted, watch
+
+    with watch():
+        try:
+            code = main()
+        except KeyboardInterrupt:
+            code = EXIT_INTERRUPTED
+        except Exception as exc:
+            code = exit_status(exc)
+            if code == EXIT_BUG:
+                raise
+            print(f"error: {error_message(exc, {'overwrite': '--force'}, code)}",
+                  file=sys.stderr)
+        if interrupted() or code == EXIT_INTERRUPTED:
+            print("interrupted", file=sys.stderr)
+            code = EXIT_INTERRUPTED
+    return code
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(_console())

@@ -36,13 +36,16 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._kernels import SINCOS_MAX_ARG, TINY, as_float_array, jit, sincos, ufunc
+from ._kernels import SINCOS_MAX_ARG, TINY, jit, sincos, ufunc
 from ._kernels.vmath import vatan2
+from .errors import ArgumentError
 
 HALF_PI = 0.5 * math.pi
 
 __all__ = [
+    "as_angle_array",
     "check_angles",
+    "check_broadcast",
     "check_zenith",
     "unit_vectors",
     "angles_from_vectors",
@@ -70,16 +73,88 @@ __all__ = [
 # --------------------------------------------------------------------------------------------
 # validation
 # --------------------------------------------------------------------------------------------
+def as_angle_array(x: ArrayLike, name: str) -> np.ndarray:
+    """``x`` as a float64 array, or :class:`~roughbrdf.errors.ArgumentError` naming ``name``.
+
+    Accepts numbers (``bool`` too) and arrays of them; ``None``, strings, complex numbers,
+    ragged or object sequences (``[0.1, None]``) and numbers beyond the float range are refused
+    with the argument's name and the value (NumPy would read ``None`` as NaN and ``"0.5"`` as
+    0.5).
+
+    Examples
+    --------
+    >>> as_angle_array([0.1, 0.2], "theta_r")
+    array([0.1, 0.2])
+    >>> as_angle_array(None, "theta_r")
+    Traceback (most recent call last):
+    ...
+    roughbrdf.errors.ArgumentError: theta_r = None: must be a number or an array of numbers \
+(radians)
+    """
+    if isinstance(x, np.ndarray) and x.dtype.kind in "fub" or isinstance(x, float | np.floating):
+        return np.asarray(x, dtype=np.float64)  # the common case, without inspecting values
+    need = "must be a number or an array of numbers (radians)"
+    if x is None or isinstance(x, str | bytes):
+        raise ArgumentError(name, need, value=x)
+    try:
+        raw = np.asarray(x)
+    except (TypeError, ValueError, OverflowError):
+        raise ArgumentError(name, need, value=_shown(x)) from None
+    if raw.dtype.kind not in "fiub":
+        bad = next((v for v in raw.ravel() if not _is_real(v)), x) if raw.dtype == object else x
+        raise ArgumentError(name, need + (f"; found {_shown(bad)!r}" if bad is not x else ""),
+                            value=_shown(x))
+    try:
+        return np.asarray(raw, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError):  # e.g. integers beyond the float range
+        raise ArgumentError(name, need, value=_shown(x)) from None
+
+
+def _is_real(v: object) -> bool:
+    # a real number that converts to float (bool, int within range, float, NumPy reals)
+    if v is None or isinstance(v, str | bytes | complex | np.complexfloating):
+        return False
+    try:
+        float(v)  # type: ignore[arg-type]
+    except (TypeError, ValueError, OverflowError):
+        return False
+    return True
+
+
+def _shown(x: object) -> object:
+    # the value as shown in a message: short arrays as lists, long ones abbreviated
+    text = repr(x)
+    return x if len(text) <= 80 else _Abbrev(text[:70] + " ...")
+
+
+class _Abbrev:
+    """A long value shown abbreviated in messages."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+
+    def __repr__(self) -> str:
+        return self.text
+
+    __str__ = __repr__
+
+
+def _first_bad(arr: np.ndarray, bad: np.ndarray) -> float:
+    return float(arr[bad].flat[0])
+
+
 def check_zenith(x: ArrayLike, name: str, *, open_upper: bool = False) -> np.ndarray:
     """Return ``x`` as a float array after checking it is a zenith angle in [0, pi/2] radians.
 
     Raises
     ------
-    ValueError
-        If any value is NaN/inf or outside ``[0, pi/2]`` (``[0, pi/2)`` with ``open_upper``);
-        the message names ``name`` and the first offending value.
+    roughbrdf.errors.ArgumentError
+        (a ``ValueError``) if ``x`` is not a number or an array of numbers (``None``
+        included), or if any value is NaN/inf or outside ``[0, pi/2]`` (``[0, pi/2)`` with
+        ``open_upper``); the message names ``name`` and the first offending value (in radians;
+        the CLI shows it in degrees).
     """
-    arr = as_float_array(x, name)
+    arr = as_angle_array(x, name)
     if arr.size:
         # fast path: two passes without temporaries (min/max propagate NaN, so NaN fails here)
         lo, hi = arr.min(), arr.max()
@@ -87,17 +162,54 @@ def check_zenith(x: ArrayLike, name: str, *, open_upper: bool = False) -> np.nda
             return arr
     bad = ~np.isfinite(arr)
     if bad.any():
-        raise ValueError(f"{name} must be finite, got {arr[bad].flat[0]!r}")
+        raise ArgumentError(name, "must be finite", value=_first_bad(arr, bad), unit="rad")
     upper = arr >= HALF_PI if open_upper else arr > HALF_PI
     bad = (arr < 0.0) | upper
     if bad.any():
-        v = float(arr[bad].flat[0])
-        rng = "[0, pi/2)" if open_upper else "[0, pi/2]"
-        raise ValueError(
-            f"{name} must be in {rng} radians, got {v!r} ({math.degrees(v):.6g} deg)"
-            + (" (the model divides by its cosine)" if open_upper and v == HALF_PI else "")
-        )
+        v = _first_bad(arr, bad)
+        rng = "[0, pi/2) rad, i.e. [0, 90) deg" if open_upper else "[0, pi/2] rad, i.e. [0, 90] deg"
+        raise ArgumentError(
+            name, f"must be in {rng}"
+            + (" (the model divides by its cosine)" if open_upper and v == HALF_PI else ""),
+            value=v, unit="rad")
     return arr
+
+
+def check_broadcast(**arrays: np.ndarray) -> tuple[int, ...]:
+    """The broadcast shape of the named arrays, or :class:`~roughbrdf.errors.ArgumentError`
+    naming the first two that do not broadcast, with their shapes.
+
+    Examples
+    --------
+    >>> check_broadcast(theta_i=np.zeros(3), theta_r=np.zeros((2, 1)))
+    (2, 3)
+    >>> check_broadcast(theta_i=np.zeros(3), theta_r=np.zeros(4))
+    Traceback (most recent call last):
+    ...
+    roughbrdf.errors.ArgumentError: theta_i (3,) and theta_r (4,) do not broadcast (NumPy \
+rules: each dimension must be equal or 1)
+    """
+    shape: tuple[int, ...] = ()
+    seen: list[tuple[str, tuple[int, ...]]] = []
+    for name, arr in arrays.items():
+        s = tuple(np.shape(arr))
+        try:
+            shape = np.broadcast_shapes(shape, s)
+        except ValueError:
+            other = next((n, t) for n, t in seen if not _broadcastable(t, s))
+            raise ArgumentError(
+                name, f"{other[0]} {other[1]} and {name} {s} do not broadcast (NumPy rules: "
+                f"each dimension must be equal or 1)") from None
+        seen.append((name, s))
+    return shape
+
+
+def _broadcastable(a: tuple[int, ...], b: tuple[int, ...]) -> bool:
+    try:
+        np.broadcast_shapes(a, b)
+    except ValueError:
+        return False
+    return True
 
 
 def check_angles(
@@ -109,16 +221,24 @@ def check_angles(
     ``cos theta_i``. ``phi`` may be any finite angle (it is periodic); azimuths beyond
     ``roughbrdf._kernels.vmath.SINCOS_MAX_ARG`` (8e5 rad) are reduced to [0, 2 pi) here, because the
     kernels' sine/cosine are accurate only up to there.
+
+    Raises
+    ------
+    roughbrdf.errors.ArgumentError
+        (a ``ValueError``) naming the argument: not a number or array of numbers (``None``
+        included), a zenith angle outside the hemisphere, a non-finite azimuth, or (naming
+        both arrays and their shapes) arrays that do not broadcast together.
     """
     ti = check_zenith(theta_i, "theta_i", open_upper=not grazing_incidence)
     tr = check_zenith(theta_r, "theta_r")
-    ph = as_float_array(phi, "phi")
+    ph = as_angle_array(phi, "phi")
     if ph.size and not (ph.min() >= -SINCOS_MAX_ARG and ph.max() <= SINCOS_MAX_ARG):
         bad = ~np.isfinite(ph)
         if bad.any():
-            raise ValueError(f"phi must be finite, got {ph[bad].flat[0]!r}")
+            raise ArgumentError("phi", "must be finite (any angle: the azimuth is periodic)",
+                                value=_first_bad(ph, bad), unit="rad")
         ph = np.mod(ph, 2.0 * math.pi)
-    np.broadcast_shapes(ti.shape, tr.shape, ph.shape)  # raises a clear NumPy error if not
+    check_broadcast(theta_i=ti, theta_r=tr, phi=ph)
     return ti, tr, ph
 
 

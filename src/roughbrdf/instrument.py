@@ -60,6 +60,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .errors import ArgumentError
 from .quantity import Quantity
 
 if TYPE_CHECKING:
@@ -81,9 +82,13 @@ APERTURE_POINTS: dict[int, tuple[int, int]] = {7: (1, 6), 19: (2, 9), 37: (3, 12
 
 
 def _check_points(points: Any) -> int:
-    if points not in APERTURE_POINTS:
-        raise ValueError(f"aperture_points must be one of {sorted(APERTURE_POINTS)}, "
-                         f"got {points!r}")
+    try:
+        ok = not isinstance(points, bool) and points in APERTURE_POINTS
+    except TypeError:  # unhashable
+        ok = False
+    if not ok:
+        raise ArgumentError("aperture_points", f"aperture_points must be one of "
+                            f"{sorted(APERTURE_POINTS)}, got {points!r}")
     return int(points)
 
 
@@ -240,8 +245,8 @@ class Aperture:
     def __post_init__(self) -> None:
         a = check_aperture(self.half_angle, self.points)
         if a is None:
-            raise ValueError("an Aperture needs a half-angle > 0; no aperture is None "
-                             "(Aperture.parse gives None for 0)")
+            raise ArgumentError("aperture", "an Aperture needs a half-angle > 0; no aperture is "
+                                "None (Aperture.parse gives None for 0)", value=self.half_angle)
         object.__setattr__(self, "half_angle", a)
         object.__setattr__(self, "points", int(self.points))
 
@@ -249,8 +254,9 @@ class Aperture:
     def parse(cls, aperture: Any, points: Any = 19) -> Aperture | None:
         """The aperture for ``aperture`` radians, or None for no aperture (None or 0).
 
-        Raises ``ValueError`` (naming ``aperture`` or ``aperture_points``) for anything else
-        than a half-angle ``0 <= aperture < pi/2`` or a stencil size of :data:`APERTURE_POINTS`.
+        Raises :class:`~roughbrdf.errors.ArgumentError` (a ``ValueError``, naming
+        ``aperture`` or ``aperture_points``) for anything else than a half-angle
+        ``0 <= aperture < pi/2`` or a stencil size of :data:`APERTURE_POINTS`.
         """
         a = check_aperture(aperture, points)
         return None if a is None else cls(a, int(points))
@@ -285,8 +291,9 @@ def check_aperture(aperture: Any, points: Any = 19) -> float | None:
 
     Raises
     ------
-    ValueError
-        ``aperture`` not a number with ``0 <= aperture < pi/2``, or ``points`` not one of
+    roughbrdf.errors.ArgumentError
+        (a ``ValueError``) ``aperture`` not a number with ``0 <= aperture < pi/2`` (the value
+        in radians, ``unit="rad"``: the CLI shows it in degrees), or ``points`` not one of
         :data:`APERTURE_POINTS`.
 
     Examples
@@ -296,15 +303,16 @@ def check_aperture(aperture: Any, points: Any = 19) -> float | None:
     """
     if aperture is None:
         return None
+    need = "must be a cone half-angle >= 0 and below 90 deg (None or 0: no aperture)"
+    if isinstance(aperture, str | bytes | bool | complex):
+        raise ArgumentError("aperture", need, value=aperture)
     try:
         a = float(aperture)
-    except (TypeError, ValueError):
-        raise ValueError(f"aperture must be None or a half-angle in radians, got "
-                         f"{aperture!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise ArgumentError("aperture", need, value=aperture) from None
     if not (math.isfinite(a) and 0.0 <= a < 0.5 * math.pi):
-        raise ValueError(f"aperture must be a half-angle in radians with 0 <= aperture < pi/2, "
-                         f"got {aperture!r}")
-    _check_points(points)
+        raise ArgumentError("aperture", need, value=a, unit="rad")
+    _check_points(points)  # only with an aperture (without one, the rule is not used)
     return a if a > 0.0 else None
 
 
@@ -434,7 +442,7 @@ def aperture_average(model: Model, theta_i: ArrayLike, theta_r: ArrayLike, phi: 
         ap = Aperture.parse(aperture, points)
     q = Quantity.parse(quantity)
     if q is Quantity.RELATIVE:  # the average of a ratio to the specular value is not defined
-        raise ValueError(f"quantity must be 'brdf' or 'bridf', got {quantity!r}")
+        raise ArgumentError("quantity", f"quantity must be 'brdf' or 'bridf', got {quantity!r}")
     g = model.prepare(theta_i, theta_r, phi, polarization)
     if ap is None:
         return model.evaluate_prepared(g, q)

@@ -23,6 +23,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .errors import ArgumentError
 from .geometry import check_zenith
 from .models.base import Model, PreparedGeometry
 from .polarization import Polarization
@@ -54,10 +55,17 @@ def albedo(model: Model, theta_i: ArrayLike, *, polarization=None, n_psi: int = 
     >>> round(float(rb.albedo(rb.model("lambertian", rho=0.5), 0.3)), 8)
     0.5
     """
+    if not isinstance(model, Model):
+        raise TypeError(f"model must be a roughbrdf Model (rb.model(...)), got "
+                        f"{type(model).__name__}")
+    for name, v, least in (("n_psi", n_psi, 4), ("n_panels", n_panels, 1), ("order", order, 1)):
+        if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < least:
+            raise ArgumentError(name, f"{name} must be an integer >= {least}, got {v!r}")
     ti = check_zenith(theta_i, "theta_i", open_upper=not model.grazing_incidence)
     gamma = Polarization.parse(polarization).gamma
     if gamma.ndim:
-        raise ValueError("albedo takes one polarization for all incidences")
+        raise ArgumentError("polarization", "albedo takes one polarization for all "
+                            "incidences (a name or one angle gamma)")
     shape = ti.shape
     t = ti.reshape(-1, 1, 1)
     u, wu = _rho_panels(n_panels, order)  # fraction of rho_max

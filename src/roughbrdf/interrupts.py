@@ -14,36 +14,58 @@ Two places must not be interrupted in the middle:
 safe point instead of disappearing. It only acts in the main thread (where Python delivers
 signals) and nests.
 
+Other code can swallow an interrupt too: any C or Cython callback, finalizer (``__del__``) or
+weak-reference callback turns the ``KeyboardInterrupt`` raised in it into an "Exception
+ignored" message (seen in SciPy's Sobol initialization and in Numba's cache loader). A program
+that must end on Ctrl-C (the command line) runs inside :func:`watch`: it records every SIGINT,
+silences those messages for ``KeyboardInterrupt`` only, and every :func:`held_interrupts`
+block, :meth:`~roughbrdf.output.ResultFolder.commit` and :func:`raise_if_interrupted` raises
+``KeyboardInterrupt`` again if one was swallowed. Outside :func:`watch` nothing changes.
+
 Examples
 --------
 >>> with held_interrupts():
 ...     pass
+>>> with watch():
+...     interrupted()
+False
 """
 
 from __future__ import annotations
 
 import contextlib
 import signal
+import sys
 import threading
 from collections.abc import Iterator
 from typing import Any
 
-__all__ = ["held_interrupts"]
+__all__ = ["held_interrupts", "watch", "interrupted", "raise_if_interrupted"]
 
 _depth = 0
 _pending: list[Any] = []
+_watching = 0
+_seen = False
+_hooks: list[Any] = []  # the unraisable hook that watch() replaced
 
 
 def _record(signum: int, frame: Any) -> None:
     _pending.append(signum)
 
 
+def _in_main_thread() -> bool:
+    return threading.current_thread() is threading.main_thread()
+
+
 @contextlib.contextmanager
 def held_interrupts() -> Iterator[None]:
-    """Defer SIGINT during the block; raise ``KeyboardInterrupt`` after it if one came."""
+    """Defer SIGINT during the block; raise ``KeyboardInterrupt`` after it if one came (or,
+    inside :func:`watch`, if one was swallowed earlier)."""
     global _depth
-    if _depth or threading.current_thread() is not threading.main_thread():
-        yield  # nested: the outer block delivers; other threads never receive signals
+    if _depth or not _in_main_thread() or signal.getsignal(signal.SIGINT) is None:
+        # nested: the outer block delivers; other threads never receive signals; a handler
+        # installed outside Python could not be put back
+        yield
         return
     try:
         previous = signal.signal(signal.SIGINT, _record)
@@ -58,7 +80,75 @@ def held_interrupts() -> Iterator[None]:
         signal.signal(signal.SIGINT, previous)
         if _pending:
             _pending.clear()
-            if callable(previous):  # the handler that was in place (Python's raises)
-                previous(signal.SIGINT, None)
-            elif previous != signal.SIG_IGN:
-                raise KeyboardInterrupt
+            _deliver(previous)
+        elif _seen:
+            raise KeyboardInterrupt
+
+
+def _deliver(handler: Any) -> None:
+    """Act on a SIGINT that arrived while held, as ``handler`` would have."""
+    if callable(handler):  # the handler that was in place (Python's raises)
+        handler(signal.SIGINT, None)
+    elif handler != signal.SIG_IGN:
+        raise KeyboardInterrupt
+
+
+# --------------------------------------------------------------------------------------------
+# programs that must end on Ctrl-C
+# --------------------------------------------------------------------------------------------
+def _on_sigint(signum: int, frame: Any) -> None:
+    global _seen
+    _seen = True
+    raise KeyboardInterrupt
+
+
+def _unraisable(info: Any) -> None:
+    """``sys.unraisablehook`` inside :func:`watch`: a swallowed ``KeyboardInterrupt`` is
+    recorded (and raised again at the next safe point) instead of printed."""
+    global _seen
+    if isinstance(info.exc_value, KeyboardInterrupt):
+        _seen = True
+        return
+    hook = _hooks[-1] if _hooks else sys.__unraisablehook__
+    hook(info)
+
+
+@contextlib.contextmanager
+def watch() -> Iterator[None]:
+    """Run a program's block so that Ctrl-C always ends it (see the module docstring).
+
+    SIGINT raises ``KeyboardInterrupt`` as usual and is also recorded; an interrupt that some
+    library swallowed is raised again by the next :func:`held_interrupts` block,
+    :meth:`~roughbrdf.output.ResultFolder.commit` or :func:`raise_if_interrupted`. Only acts in
+    the main thread; nests (the outer block is the one that counts).
+    """
+    global _watching, _seen
+    if _watching or not _in_main_thread() or signal.getsignal(signal.SIGINT) is None:
+        yield
+        return
+    try:
+        previous = signal.signal(signal.SIGINT, _on_sigint)
+    except (ValueError, OSError):
+        yield
+        return
+    _hooks.append(sys.unraisablehook)
+    sys.unraisablehook = _unraisable
+    _watching, _seen = 1, False
+    try:
+        yield
+    finally:
+        _watching, _seen = 0, False
+        sys.unraisablehook = _hooks.pop()
+        if signal.getsignal(signal.SIGINT) is _on_sigint:  # unless the block replaced it
+            signal.signal(signal.SIGINT, previous)
+
+
+def interrupted() -> bool:
+    """Whether Ctrl-C was pressed inside the current :func:`watch` block."""
+    return _seen
+
+
+def raise_if_interrupted() -> None:
+    """Raise ``KeyboardInterrupt`` if Ctrl-C was pressed inside :func:`watch` (and swallowed)."""
+    if _seen:
+        raise KeyboardInterrupt

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from .errors import ArgumentError
 from .geometry import check_angles
 from .quantity import Quantity
 
@@ -56,7 +57,10 @@ class Measurement:
         shape (N,), in the file's own units (``meta["original_units"]`` says which).
     meta : dict
         Provenance: ``file``, ``format``, ``sample``, ``instrument``, ``date`` and anything else
-        the reader found (the raw header is under ``meta["header"]``).
+        the reader found. The file's header keys, as read, are under ``meta["header"]`` (a
+        writer of the same format writes them all back); ``meta["file_abs"]`` is the absolute
+        path of the file read, which no writer replaces
+        (:func:`roughbrdf.io.write` refuses it even with ``overwrite=True``).
     """
 
     theta_i: np.ndarray
@@ -99,6 +103,9 @@ class Measurement:
             raise ValueError(f"{exc}{where}") from None
         try:
             check_angles(self.theta_i, self.theta_r, self.phi)
+        except ArgumentError as exc:  # keep the argument's name, value and unit (CLI wording)
+            raise ArgumentError(exc.argument, f"{exc.message}{where}", value=exc.value,
+                                fix=exc.fix, unit=exc.unit) from exc
         except ValueError as exc:
             raise ValueError(f"{exc}{where}") from exc
         if self.polarization is not None:

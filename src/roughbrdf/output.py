@@ -1,13 +1,15 @@
 """Writing files without losing anything a user has: atomic writes, no overwrite unless asked.
 
-Every file roughbrdf writes goes through :func:`atomic_write`:
+Every file roughbrdf writes goes through :func:`atomic_write` (one file) or
+:class:`ResultFolder` (a set of files):
 
 * an existing file is never replaced unless the caller asks (``overwrite=True``; the CLI's
-  ``--force``): :class:`FileExistsError` names it otherwise;
+  ``--force``): :class:`OverwriteRefused` (a :class:`FileExistsError`) names it otherwise;
 * the content goes to a temporary file in the same folder, which is then renamed over the
   target (:func:`os.replace`, atomic on POSIX and Windows): a reader, a crash or Ctrl-C sees the
   old file or the new one, never a mix and never a 0-byte file;
-* if writing fails or is interrupted, the temporary file is removed and the error propagates.
+* if writing fails or is interrupted, the temporary file is removed and the error propagates;
+  an :class:`OSError` names the file or folder it is about, not the temporary file.
 
 Examples
 --------
@@ -18,7 +20,7 @@ PosixPath('...a.txt')
 >>> atomic_write(d / "a.txt", "second\\n")
 Traceback (most recent call last):
 ...
-FileExistsError: ...a.txt exists; not overwriting it (pass overwrite=True)
+roughbrdf.output.OverwriteRefused: ...a.txt exists; not overwriting it (pass overwrite=True)
 >>> _ = atomic_write(d / "a.txt", "second\\n", overwrite=True)
 >>> (d / "a.txt").read_text()
 'second\\n'
@@ -27,16 +29,73 @@ FileExistsError: ...a.txt exists; not overwriting it (pass overwrite=True)
 from __future__ import annotations
 
 import contextlib
+import errno
+import json
 import os
 import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import IO, Any
 
-__all__ = ["atomic_write", "staged", "same_file", "ResultFolder", "MANIFEST", "LOCK"]
+from .interrupts import held_interrupts, raise_if_interrupted
+
+__all__ = ["atomic_write", "staged", "same_file", "ensure_folder", "ResultFolder",
+           "OverwriteRefused", "MANIFEST", "LOCK", "TMP_PREFIX"]
 
 #: prefix of the temporary files (a leftover one, after a power cut, is recognizable)
 TMP_PREFIX = ".roughbrdf-tmp-"
+
+Content = str | bytes | Callable[[IO[Any]], None]
+
+
+class OverwriteRefused(FileExistsError):
+    """roughbrdf refused to replace files (a rule of this module, not an error of the system).
+
+    Attributes
+    ----------
+    path : pathlib.Path
+        The file, or the results folder.
+    results : list of str
+        Files of an earlier run (the folder's :data:`MANIFEST`) that would be replaced.
+    foreign : list of str
+        Files of the same names that roughbrdf did not write: never replaced.
+    locked : bool
+        Another run is writing into the folder (its :data:`LOCK`).
+
+    :meth:`render` words the message for Python (``overwrite=True``) or, given
+    ``{"overwrite": "--force"}``, for the command line; ``str(err)`` is the Python wording.
+    """
+
+    def __init__(self, path: str | os.PathLike, *, results: Iterable[str] = (),
+                 foreign: Iterable[str] = (), overwrite: bool = False, locked: bool = False,
+                 single: bool = False) -> None:
+        self.path = Path(path)
+        self.results = sorted(results)
+        self.foreign = sorted(foreign)
+        self.overwrite = overwrite
+        self.locked = locked
+        self.single = single
+        super().__init__(self.render())
+
+    def render(self, options: Mapping[str, str] | None = None) -> str:
+        """The message; ``options["overwrite"]`` is how the caller says "replace" (``--force``)."""
+        ask = (options or {}).get("overwrite", "overwrite=True")
+        if self.locked:
+            return (f"another roughbrdf run is writing into {self.path} (lock file "
+                    f"{self.path / LOCK}); wait for it to finish, or delete the lock file if no "
+                    f"run is active")
+        if self.single:
+            return f"{self.path} exists; not overwriting it (pass {ask})"
+        parts = []
+        if self.results:
+            parts.append(f"{self.path} holds results already ({', '.join(self.results)}); "
+                         f"choose another folder or replace them with {ask}")
+        if self.foreign:
+            them = "it" if len(self.foreign) == 1 else "them"
+            even = f", not even with {ask}" if self.overwrite else ""
+            parts.append(f"{self.path}: not overwriting {', '.join(self.foreign)} (not written by "
+                         f"roughbrdf{even}); move {them} away or choose another folder")
+        return "; ".join(parts)
 
 
 def same_file(a: str | os.PathLike, b: str | os.PathLike) -> bool:
@@ -47,36 +106,122 @@ def same_file(a: str | os.PathLike, b: str | os.PathLike) -> bool:
         return False
 
 
+def _located(exc: OSError, path: str | os.PathLike) -> OSError:
+    """``exc`` (same class and errno) about ``path`` instead of a temporary file."""
+    if exc.errno is None:
+        return exc
+    try:
+        new = type(exc)(exc.errno, exc.strerror, str(path))
+    except TypeError:  # a subclass with a constructor of its own
+        return exc
+    new.__cause__ = exc
+    return new
+
+
+#: errors of writing a file's bytes (reported against the file, not the temporary one)
+_WRITE_ERRORS = (errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC), errno.EIO, errno.EFBIG)
+
+
+def _blocking_file(path: Path) -> Path | None:
+    """The first of ``path`` and its ancestors that exists and is not a folder, if any."""
+    for p in (path, *path.parents):
+        if p.exists() or p.is_symlink():
+            return None if p.is_dir() else p
+    return None
+
+
+def ensure_folder(path: str | os.PathLike) -> Path:
+    """Create the folder ``path`` (and its parents) if needed; returns it.
+
+    Raises :class:`NotADirectoryError` naming the file in the way when ``path`` or one of its
+    parents is a file.
+    """
+    folder = Path(path)
+    block = _blocking_file(folder)
+    if block is not None:
+        where = "" if block == folder else f" ({block} is a file)"
+        raise NotADirectoryError(errno.ENOTDIR, f"not a folder{where}", str(folder))
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
+
+
+def _temporary(folder: Path, target: Path, binary: bool) -> tuple[str, IO[Any]]:
+    """A new temporary file in ``folder``, open (errors name ``folder`` or ``target``)."""
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=TMP_PREFIX, suffix=".part", dir=folder)
+    except FileNotFoundError as exc:
+        raise _located(exc, folder) from None
+    except OSError as exc:
+        raise _located(exc, target) from None
+    fh: IO[Any] = (os.fdopen(fd, "wb") if binary
+                   else os.fdopen(fd, "w", encoding="utf-8", newline=""))
+    return tmp, fh
+
+
+@contextlib.contextmanager
+def _on_disk(fh: IO[Any], target: Path) -> Iterator[IO[Any]]:
+    """Yield ``fh``; then flush it to disk and close it (write errors name ``target``)."""
+    try:
+        with fh:
+            yield fh
+            fh.flush()
+            os.fsync(fh.fileno())  # the bytes are on disk before the name points at them
+    except OSError as exc:
+        if exc.errno in _WRITE_ERRORS:
+            raise _located(exc, target) from None
+        raise
+
+
 @contextlib.contextmanager
 def staged(path: str | os.PathLike, *, overwrite: bool = False, binary: bool = False
            ) -> Iterator[IO[Any]]:
     """Open a temporary file beside ``path``; on a clean exit it replaces ``path`` atomically.
 
-    Raises :class:`FileExistsError` before anything is written if ``path`` exists and
-    ``overwrite`` is false, and :class:`IsADirectoryError` if ``path`` is a folder. On any
-    exception (``KeyboardInterrupt`` included) the temporary file is removed and ``path`` is
-    left as it was.
+    Raises :class:`OverwriteRefused` before anything is written if ``path`` exists and
+    ``overwrite`` is false (also if the file appears meanwhile: the final rename does not
+    replace it), and :class:`IsADirectoryError` if ``path`` is a folder. On any exception
+    (``KeyboardInterrupt`` included) the temporary file is removed and ``path`` is left as it
+    was.
     """
     target = Path(path)
     if target.is_dir():
-        raise IsADirectoryError(f"{target} is a folder, not a file")
+        raise IsADirectoryError(errno.EISDIR, "a folder, not a file", str(target))
     if target.exists() and not overwrite:
-        raise FileExistsError(f"{target} exists; not overwriting it (pass overwrite=True)")
+        raise OverwriteRefused(target, single=True)
     folder = target.parent if str(target.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=TMP_PREFIX, suffix=".part", dir=folder)
+    tmp: str | None = None
+    fh: IO[Any] | None = None
     try:
-        fh_: IO[Any] = (os.fdopen(fd, "wb") if binary
-                        else os.fdopen(fd, "w", encoding="utf-8", newline=""))
-        with fh_ as fh:
-            yield fh
-            fh.flush()
-            os.fsync(fh.fileno())  # the bytes are on disk before the name points at them
+        with held_interrupts():  # the name is recorded before an interrupt can strike
+            tmp, fh = _temporary(folder, target, binary)
+        with _on_disk(fh, target) as out:
+            yield out
         _keep_mode(target, tmp)
+        _put(tmp, target, overwrite)
+        tmp = None
+    finally:
+        if fh is not None and not fh.closed:
+            fh.close()
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+
+
+def _put(tmp: str, target: Path, overwrite: bool) -> None:
+    """Rename ``tmp`` to ``target``; without ``overwrite`` never over an existing file."""
+    if overwrite:
         os.replace(tmp, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
+        return
+    try:
+        os.link(tmp, target)  # atomic and fails if target exists (no race with a new file)
+    except FileExistsError:
+        raise OverwriteRefused(target, single=True) from None
+    except OSError:  # no hard links here (some network or FAT file systems)
+        if target.exists():
+            raise OverwriteRefused(target, single=True) from None
+        os.replace(tmp, target)
+        return
+    os.unlink(tmp)
 
 
 def _keep_mode(target: Path, tmp: str) -> None:
@@ -91,8 +236,8 @@ def _keep_mode(target: Path, tmp: str) -> None:
     os.chmod(tmp, mode)
 
 
-def atomic_write(path: str | os.PathLike, content: str | bytes | Callable[[IO[Any]], None], *,
-                 overwrite: bool = False, binary: bool | None = None) -> Path:
+def atomic_write(path: str | os.PathLike, content: Content, *, overwrite: bool = False,
+                 binary: bool | None = None) -> Path:
     """Write ``content`` to ``path`` atomically; see the module docstring for the rules.
 
     Parameters
@@ -102,7 +247,7 @@ def atomic_write(path: str | os.PathLike, content: str | bytes | Callable[[IO[An
         The text or bytes to write, or a function that writes to the open file it is given
         (text mode unless ``binary=True``).
     overwrite : bool
-        Replace an existing file (default: refuse with :class:`FileExistsError`).
+        Replace an existing file (default: refuse with :class:`OverwriteRefused`).
     binary : bool, optional
         Open the file in binary mode (default: for ``bytes`` content).
 
@@ -141,33 +286,40 @@ class ResultFolder:
 
     Rules (the CLI's ``--force`` is ``overwrite=True``):
 
-    * **refuse** (:class:`FileExistsError`, naming the files) if the folder holds the results of
-      an earlier run (its :data:`MANIFEST`) or any file this set would write, unless
-      ``overwrite``; even then a file of the same name that roughbrdf did not write is refused
-      (move it away): files the user made are never replaced;
+    * **refuse** (:class:`OverwriteRefused`, naming the files) if the folder holds the results
+      of an earlier run (files its :data:`MANIFEST` lists) or any file this set would write,
+      unless ``overwrite``; even then a file of the same name that roughbrdf did not write is
+      refused (move it away): files the user made are never replaced;
     * with ``overwrite``, the new set replaces exactly the old one: files of the old set that
       the new one does not write are removed, every other file stays;
+    * ``extend=True`` adds files to the folder's set instead (``roughbrdf plot --fit DIR``
+      adds its figures to the fit's results): the old set stays, and only files of the same
+      names are replaced (with ``overwrite``);
     * **all or nothing**: each file is written to a temporary file in the folder first; only
       when all are written are they renamed into place, with Ctrl-C held
       (:func:`roughbrdf.interrupts.held_interrupts`), then the manifest, then the stale files
       go. An error or interrupt before that removes the temporary files and leaves the old set
-      as it was;
+      as it was; the manifest only ever lists files that exist;
     * **one run at a time**: :data:`LOCK` is created exclusively; a second run is refused with a
       message naming the lock (a lock left by a process that no longer exists is taken over).
     """
 
-    def __init__(self, path: str | os.PathLike, *, overwrite: bool = False) -> None:
+    def __init__(self, path: str | os.PathLike, *, overwrite: bool = False,
+                 extend: bool = False) -> None:
         self.path = Path(path)
         self.overwrite = overwrite
+        self.extend = extend
         self._staged: dict[str, str] = {}  # name -> temporary file
         self._locked = False
 
     # -- context ---------------------------------------------------------------------------
     def __enter__(self) -> ResultFolder:
-        if self.path.exists() and not self.path.is_dir():
-            raise NotADirectoryError(f"{self.path} exists and is not a folder")
-        self.path.mkdir(parents=True, exist_ok=True)
-        self._lock()
+        ensure_folder(self.path)
+        try:
+            self._lock()
+        except BaseException:
+            self._unlock()
+            raise
         return self
 
     def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
@@ -175,14 +327,13 @@ class ResultFolder:
             if exc_type is None:
                 self.commit()
         finally:
-            self._discard()
-            self._unlock()
+            with held_interrupts():  # a second Ctrl-C must not leave temporary files behind
+                self._discard()
+                self._unlock()
 
     # -- content ---------------------------------------------------------------------------
     def previous(self) -> list[str]:
         """Names the folder's manifest lists (the last committed set), empty if none."""
-        import json
-
         m = self.path / MANIFEST
         try:
             data = json.loads(m.read_text(encoding="utf-8"))
@@ -190,55 +341,83 @@ class ResultFolder:
             return []
         return [str(x) for x in data] if isinstance(data, list) else []
 
-    def check(self, names: list[str]) -> None:
-        """Raise :class:`FileExistsError` if writing ``names`` here would replace anything the
-        rules do not allow (call it before expensive work)."""
-        old = set(self.previous())
-        if not self.overwrite:
-            clash = sorted(old | {n for n in names if (self.path / n).exists()})
-            if clash:
-                raise FileExistsError(
-                    f"{self.path} holds results already ({', '.join(clash)}); choose another "
-                    f"folder or replace them with --force (overwrite=True)")
-            return
-        foreign = sorted(n for n in names if (self.path / n).exists() and n not in old)
-        if foreign:
-            raise FileExistsError(
-                f"{self.path}: {', '.join(foreign)} not written by roughbrdf; not replacing "
-                f"it even with --force (move it away or choose another folder)")
+    def check(self, names: Iterable[str]) -> None:
+        """Raise if writing ``names`` here would break a rule (call it before expensive work).
 
-    def add(self, name: str, content: str | bytes | Callable[[IO[Any]], None], *,
-            binary: bool | None = None) -> Path:
+        :class:`OverwriteRefused` for files the rules do not let this set replace or a folder
+        another run is writing into; :class:`NotADirectoryError` if the folder or one of its
+        parents is a file; :class:`PermissionError` if the folder (or the nearest existing
+        parent, where it would be created) cannot be written.
+        """
+        names = list(names)
+        self._check_location()
+        if not self._locked and (self.path / LOCK).exists() \
+                and not _lock_is_stale(self.path / LOCK):
+            raise OverwriteRefused(self.path, locked=True)
+        old = set(self.previous())
+        present = {n for n in names if (self.path / n).exists()}
+        foreign = present - old
+        if self.extend:
+            results = present & old
+        else:
+            results = {n for n in old if (self.path / n).exists()}
+        if foreign or (results and not self.overwrite):
+            raise OverwriteRefused(self.path, results=() if self.overwrite else results,
+                                   foreign=foreign, overwrite=self.overwrite)
+
+    def _check_location(self) -> None:
+        block = _blocking_file(self.path)
+        if block is not None:
+            where = "" if block == self.path else f" ({block} is a file)"
+            raise NotADirectoryError(errno.ENOTDIR, f"not a folder{where}", str(self.path))
+        existing = next(p for p in (self.path, *self.path.parents, Path(".")) if p.exists())
+        if not os.access(existing, os.W_OK | os.X_OK):
+            raise PermissionError(errno.EACCES, "permission denied (cannot write there)",
+                                  str(self.path if existing == self.path else existing))
+
+    def add(self, name: str, content: Content, *, binary: bool | None = None) -> Path:
         """Stage ``name`` (text, bytes, or a function writing to the open file); returns the
         path it will have once committed."""
-        if os.sep in name or name in (MANIFEST, LOCK) or name.startswith("."):
+        if os.sep in name or "/" in name or name in (MANIFEST, LOCK) or name.startswith("."):
             raise ValueError(f"not a result file name: {name!r}")
         is_binary = isinstance(content, bytes) if binary is None else binary
-        fd, tmp = tempfile.mkstemp(prefix=TMP_PREFIX, suffix=".part", dir=self.path)
-        self._staged[name] = tmp
-        fh_: IO[Any] = (os.fdopen(fd, "wb") if is_binary
-                        else os.fdopen(fd, "w", encoding="utf-8", newline=""))
-        with fh_ as fh:
-            if callable(content):
-                content(fh)
-            else:
-                fh.write(content)
-            fh.flush()
-            os.fsync(fh.fileno())
+        fh: IO[Any] | None = None
+        try:
+            with held_interrupts():  # the temporary file is recorded before an interrupt
+                if name in self._staged:  # staged twice: the later content wins
+                    with contextlib.suppress(OSError):
+                        os.unlink(self._staged.pop(name))
+                tmp, fh = _temporary(self.path, self.path / name, is_binary)
+                self._staged[name] = tmp
+            with _on_disk(fh, self.path / name) as out:
+                if callable(content):
+                    content(out)
+                else:
+                    out.write(content)
+        except BaseException:  # a file that failed is not part of the set
+            if name in self._staged:
+                with contextlib.suppress(OSError):
+                    os.unlink(self._staged.pop(name))
+            raise
+        finally:
+            if fh is not None and not fh.closed:
+                fh.close()
         return self.path / name
 
     def commit(self) -> list[Path]:
         """Put the staged set in place (see the class docstring); returns the paths."""
-        from .interrupts import held_interrupts
-
+        raise_if_interrupted()  # a Ctrl-C that a library swallowed still stops the commit
         names = sorted(self._staged)
         self.check(names)
-        stale = [n for n in self.previous() if n not in self._staged]
+        old = [n for n in self.previous() if (self.path / n).exists()]
+        stale = [] if self.extend else [n for n in old if n not in self._staged]
+        listed = sorted(set(names) | set(old)) if self.extend else names
         with held_interrupts():
             for name in names:
                 _keep_mode(self.path / name, self._staged[name])
-                os.replace(self._staged.pop(name), self.path / name)
-            _write_manifest(self.path, names)
+                os.replace(self._staged[name], self.path / name)
+                del self._staged[name]
+            _write_manifest(self.path, listed)
             for n in stale:
                 with contextlib.suppress(FileNotFoundError):
                     (self.path / n).unlink()
@@ -248,21 +427,22 @@ class ResultFolder:
     def _lock(self) -> None:
         lock = self.path / LOCK
         for _ in range(2):
-            try:
-                fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
-            except FileExistsError:
-                if _lock_is_stale(lock):
-                    with contextlib.suppress(FileNotFoundError):
-                        lock.unlink()
-                    continue
-                raise FileExistsError(
-                    f"another roughbrdf run is writing into {self.path} (lock file {lock}); "
-                    f"wait for it to finish, or delete the lock file if no run is active"
-                ) from None
-            with os.fdopen(fd, "w") as fh:
-                fh.write(f"{os.getpid()}\n")
-            self._locked = True
-            return
+            with held_interrupts():  # never leave an empty lock file behind
+                try:
+                    fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+                except FileExistsError:
+                    fd = -1
+                else:
+                    self._locked = True
+                    with os.fdopen(fd, "w") as fh:
+                        fh.write(f"{os.getpid()}\n")
+            if self._locked:
+                return
+            if not _lock_is_stale(lock):
+                raise OverwriteRefused(self.path, locked=True)
+            with contextlib.suppress(FileNotFoundError):
+                lock.unlink()
+        raise OverwriteRefused(self.path, locked=True)
 
     def _unlock(self) -> None:
         if self._locked:
@@ -278,8 +458,6 @@ class ResultFolder:
 
 
 def _write_manifest(folder: Path, names: list[str]) -> None:
-    import json
-
     atomic_write(folder / MANIFEST, json.dumps(names, indent=1) + "\n", overwrite=True)
 
 
@@ -287,12 +465,18 @@ def _lock_is_stale(lock: Path) -> bool:
     """Whether ``lock`` names a process that no longer exists (on this machine)."""
     try:
         pid = int(lock.read_text().split()[0])
+    except FileNotFoundError:
+        return True  # gone meanwhile
     except (OSError, ValueError, IndexError):
         return False  # being written right now, or not ours: treat as held
+    if pid == os.getpid() or os.name == "nt":
+        # this process writes there (another ResultFolder of ours); on Windows os.kill(pid, 0)
+        # would end the process instead of asking whether it exists: the lock counts as held
+        return False
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return True
-    except PermissionError:
+    except (PermissionError, OverflowError):
         return False
     return False

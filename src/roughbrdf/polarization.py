@@ -24,11 +24,13 @@ True
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from .errors import ArgumentError
 from .fresnel import polarization_angle
 
 __all__ = ["Polarization"]
@@ -54,8 +56,9 @@ class Polarization:
 
     def __post_init__(self) -> None:
         if self.stokes is not None or self.analyzer is not None:
-            raise ValueError("polarization: an incident Stokes vector or an analyzer is not "
-                             "supported by this version (use 's', 'p' or an angle gamma)")
+            raise ArgumentError("polarization", "polarization: an incident Stokes vector or an "
+                                "analyzer is not supported by this version (use 's', 'p' or "
+                                "an angle gamma)")
 
     @classmethod
     def unpolarized(cls) -> Polarization:
@@ -71,31 +74,57 @@ class Polarization:
     def parse(cls, value: Any) -> Polarization:
         """A :class:`Polarization` from any accepted ``polarization=`` argument.
 
-        Raises ``ValueError`` naming the offending value for an unknown name, a non-numeric
-        value or an infinite angle.
+        Raises :class:`~roughbrdf.errors.ArgumentError` (a ``ValueError``) naming
+        ``polarization`` and the offending value for an unknown name, a value that is not a
+        real number (complex, bytes, a dict ...), an infinite angle or a ragged array.
         """
         if isinstance(value, Polarization):
             return value
-        if value is None or isinstance(value, str | float | int):
-            return cls(np.asarray(polarization_angle(value), dtype=np.float64))
-        arr = np.asarray(value)
-        if arr.dtype.kind in "US" or arr.dtype == object:
-            try:
-                gam = np.vectorize(polarization_angle, otypes=[np.float64])(arr)
-            except TypeError as exc:
-                raise ValueError(f"polarization must be 's', 'p', 'unpolarized' or angles in "
-                                 f"radians, got {value!r}") from exc
-            return cls(gam)
+        if value is None or isinstance(value, str):
+            return cls(np.asarray(_gamma(value), dtype=np.float64))
+        if isinstance(value, bool | int | float | np.integer | np.floating):
+            return cls(np.asarray(_gamma(value), dtype=np.float64))
         try:
+            arr = np.asarray(value)
+        except (TypeError, ValueError, OverflowError):
+            raise _bad(value) from None
+        if arr.dtype.kind in "biuf":
             gam = np.asarray(arr, dtype=np.float64)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"polarization must be numeric, got {value!r}") from exc
-        if np.isinf(gam).any():
-            bad = gam[np.isinf(gam)].flat[0]
-            raise ValueError(f"polarization angle gamma must be finite, got {bad!r}")
-        return cls(gam)  # NaN entries mean unpolarized
+            if np.isinf(gam).any():
+                _gamma(float(gam[np.isinf(gam)].flat[0]))  # raises naming the value
+            return cls(gam)  # NaN entries mean unpolarized
+        if arr.dtype.kind in "UO":
+            return cls(np.vectorize(_gamma, otypes=[np.float64])(arr))
+        raise _bad(value)
 
     @property
     def is_unpolarized(self) -> bool:
         """Whether every sample is unpolarized."""
         return bool(np.isnan(self.gamma).all())
+
+
+def _bad(value: Any) -> ArgumentError:
+    shown = repr(value)
+    shown = shown if len(shown) <= 80 else shown[:70] + " ..."
+    return ArgumentError("polarization", f"polarization must be 's', 'p', 'unpolarized' (None) "
+                         f"or an angle gamma in radians, got {shown}")
+
+
+def _gamma(value: Any) -> float:
+    """TR75's gamma of one polarization value (a name, None or a real number)."""
+    if value is None or isinstance(value, str):
+        name: str | None = value
+        try:
+            return polarization_angle(name)
+        except ValueError:
+            raise _bad(value) from None
+    if not isinstance(value, bool | int | float | np.integer | np.floating):
+        raise _bad(value)
+    try:
+        g = float(value)
+    except OverflowError:  # an int beyond the float range
+        raise _bad(value) from None
+    if not math.isfinite(g):
+        raise ArgumentError("polarization", "the polarization angle gamma must be finite",
+                            value=g, unit="rad")
+    return g

@@ -1,30 +1,157 @@
 """Command-line interface (Typer). Angles are in degrees at this edge; verbs mirror the library.
 
 Each verb lives in its own module with a ``register(app)`` function; :data:`VERBS` lists them.
+The Typer application :data:`app` is built on first use, so that :func:`main` can catch Ctrl-C
+from its very first line (importing Typer alone takes tens of milliseconds).
+
+Exit statuses
+-------------
+====  ==========================================================================================
+0     success
+1     a fit did not converge (``success`` false for some channel); its results are written
+2     usage error, bad input (arguments, a measurement file that cannot be read), or files that
+      roughbrdf refuses to replace (``--force``) or a folder another run is writing into
+3     error of the operating system: permission denied, read-only or full disk, a folder where
+      a file is expected or a file where a folder is expected
+4     internal error (a bug in roughbrdf: ``--debug`` shows the traceback)
+130   interrupted (Ctrl-C); nothing half-written is left behind
+====  ==========================================================================================
+
+Every error is one line on stderr naming what is wrong (``roughbrdf --debug VERB ...`` adds the
+traceback); an interrupt prints ``interrupted``.
 """
 
 from __future__ import annotations
 
-import importlib
+import sys
+from typing import TYPE_CHECKING, Any
 
-import typer
+if TYPE_CHECKING:
+    import typer
 
-app = typer.Typer(add_completion=False, no_args_is_help=True,
-                  help="roughbrdf: rough-surface BRDF models - evaluate, fit, reproduce, convert.")
+    app: typer.Typer
+
+__all__ = ["app", "main", "build_app", "get_app", "VERBS", "EXIT_OK", "EXIT_NOT_CONVERGED",
+           "EXIT_USAGE", "EXIT_OS", "EXIT_BUG", "EXIT_INTERRUPTED"]
+
+EXIT_OK = 0
+EXIT_NOT_CONVERGED = 1
+EXIT_USAGE = 2
+EXIT_OS = 3
+EXIT_BUG = 4
+EXIT_INTERRUPTED = 130
 
 #: modules under roughbrdf.cli that register verbs (each defines register(app))
 VERBS = ["evaluate", "fit", "convert", "plot", "reproduce"]
 
-for _name in VERBS:
+_APP: list[Any] = []
+
+
+class _Run:
+    """State of the current command line run (set by the verbs, read by :func:`main`)."""
+
+    debug = False
+    interrupt_reported = False
+
+
+def build_app() -> typer.Typer:
+    """A new Typer application with every verb of :data:`VERBS` registered."""
+    import importlib
+
+    import typer
+
+    new = typer.Typer(add_completion=False, no_args_is_help=True,
+                      help="roughbrdf: rough-surface BRDF models - evaluate, fit, reproduce, "
+                           "convert.")
+
+    @new.callback()
+    def _options(debug: bool = typer.Option(
+            False, "--debug", help="on an error, also show the traceback")) -> None:
+        _Run.debug = debug
+        _Run.interrupt_reported = False
+
+    for name in VERBS:
+        try:
+            mod = importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as exc:  # verb not written yet
+            if exc.name != f"{__name__}.{name}":
+                raise
+            continue
+        mod.register(new)
+    return new
+
+
+def get_app() -> typer.Typer:
+    """The application (:data:`app`), built on the first call."""
+    if not _APP:
+        _APP.append(build_app())
+    return _APP[0]
+
+
+def __getattr__(name: str) -> Any:
+    if name == "app":
+        return get_app()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line (``argv``, default ``sys.argv[1:]``); returns the exit status.
+
+    Ctrl-C at any moment ends the run with :data:`EXIT_INTERRUPTED` and the one line
+    ``interrupted`` (also when a library swallowed the ``KeyboardInterrupt``:
+    :func:`roughbrdf.interrupts.watch`). As the console script (``argv`` None), a Ctrl-C that
+    comes after the command has ended is ignored: only Python's shutdown is left.
+    """
+    from ..interrupts import interrupted, watch
+
+    _Run.debug = "--debug" in (sys.argv[1:] if argv is None else argv)  # until parsed
+    _Run.interrupt_reported = False
+    with watch():
+        try:
+            code = _run(argv)
+        except KeyboardInterrupt:
+            code = EXIT_INTERRUPTED
+        if interrupted():
+            code = EXIT_INTERRUPTED
+        if code == EXIT_INTERRUPTED and not _Run.interrupt_reported:
+            _say("interrupted")
+            _Run.interrupt_reported = True
+        if argv is None:
+            _ignore_sigint()
+    return code
+
+
+def _run(argv: list[str] | None) -> int:
+    """Build the application and run it in standalone mode; its exit status."""
     try:
-        _mod = importlib.import_module(f"{__name__}.{_name}")
-    except ModuleNotFoundError as exc:  # verb not written yet
-        if exc.name != f"{__name__}.{_name}":
-            raise
-        continue
-    _mod.register(app)
+        get_app()(args=argv, prog_name="roughbrdf")
+    except SystemExit as exc:
+        if exc.code is None or isinstance(exc.code, int):
+            return int(exc.code or 0)
+        _say(str(exc.code))
+        return EXIT_USAGE
+    except Exception as exc:  # not handled by a verb: a bug
+        import traceback
+
+        if _Run.debug:
+            traceback.print_exception(exc, file=sys.stderr)
+        _say(f"error: internal error: {type(exc).__name__}: {exc} (a bug in roughbrdf; "
+             f"`roughbrdf --debug ...` shows the traceback)")
+        return EXIT_BUG
+    return EXIT_OK
 
 
-def main() -> None:
-    """Console-script entry point."""
-    app()
+def _say(line: str) -> None:
+    try:
+        print(line, file=sys.stderr, flush=True)
+    except (OSError, ValueError):  # stderr closed or a broken pipe: nothing more to do
+        pass
+
+
+def _ignore_sigint() -> None:
+    import signal
+
+    try:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except (ValueError, OSError):
+        pass

@@ -7,19 +7,35 @@ from typing import Annotated
 
 import typer
 
-from .common import degree_range, parse_params
+from .common import degree_range, handled, parse_params
+
+#: the library's argument names -> this verb's options (errors name the options)
+OPTIONS = {"theta_i": "--theta-i", "theta_r": "--theta-r", "phi": "--phi",
+           "polarization": "--polarization", "gamma": "--polarization", "quantity": "--quantity"}
+
+
+def describe_with_aliases(name: str) -> str:
+    """``Model.describe()`` of model ``name`` with a line listing its aliases."""
+    from .. import models as _models
+
+    m = _models.model(name)
+    lines = m.describe().splitlines()
+    aliases = tuple(getattr(type(m), "aliases", ()))
+    if aliases:
+        lines.insert(1, f"  aliases: {', '.join(aliases)}")
+    return "\n".join(lines)
 
 
 def register(app: typer.Typer) -> None:
     @app.command("models")
     def models_cmd() -> None:
-        """List the registered models with their parameters and units."""
+        """List the registered models with their aliases, parameters and units."""
         from .. import models as _models
 
-        for name in _models.available():
-            m = _models.model(name)
-            typer.echo(m.describe())
-            typer.echo("")
+        with handled():
+            for name in _models.available():
+                typer.echo(describe_with_aliases(name))
+                typer.echo("")
 
     @app.command("eval")
     def eval_cmd(
@@ -35,31 +51,35 @@ def register(app: typer.Typer) -> None:
         polarization: Annotated[str, typer.Option(
             help="unpolarized, s, p or gamma in DEG")] = "unpolarized",
         quantity: Annotated[str, typer.Option(
-            help="brdf, brdf_cos (= bridf) or relative (to the specular value)")] = "brdf",
+            help="output: the quantity printed, brdf, brdf_cos (= bridf), bridf or relative "
+                 "(to the specular value)")] = "brdf",
     ) -> None:
         """Evaluate a model on a grid of angles (degrees) and print CSV."""
-        import numpy as np
+        with handled(OPTIONS):
+            _evaluate(model, parse_params(param), theta_i, theta_r, phi, polarization, quantity)
 
-        from .. import models as _models
-        from ..quantity import Quantity
 
-        try:
-            m = _models.model(model, **parse_params(param))
-            ti = degree_range(theta_i, "--theta-i")
-            tr = degree_range(theta_r, "--theta-r")
-            ph = degree_range(phi, "--phi")
-            try:
-                pol: object = np.radians(float(polarization))
-            except ValueError:
-                pol = polarization
-            q = Quantity.parse(quantity, "--quantity")
-            TI, TR, PH = (a.reshape(-1) for a in np.meshgrid(ti, tr, ph, indexing="ij"))
-            f = m.evaluate(TI, TR, PH, quantity=q, polarization=pol)
-        except ValueError as exc:
-            typer.echo(f"error: {exc}", err=True)
-            raise typer.Exit(2) from exc
-        w = sys.stdout
-        w.write(f"theta_i_deg,theta_r_deg,phi_deg,{quantity}\n")
-        for a, b, c, v in zip(np.degrees(TI), np.degrees(TR), np.degrees(PH), np.atleast_1d(f),
-                              strict=True):
-            w.write(f"{a:.6g},{b:.6g},{c:.6g},{v:.10g}\n")
+def _evaluate(model: str, params: dict, theta_i: str, theta_r: str, phi: str,
+              polarization: str, quantity: str) -> None:
+    """The work of ``roughbrdf eval``: the CSV table on stdout."""
+    import numpy as np
+
+    from .. import models as _models
+    from ..quantity import Quantity
+
+    m = _models.model(model, **params)
+    ti = degree_range(theta_i, "--theta-i")
+    tr = degree_range(theta_r, "--theta-r")
+    ph = degree_range(phi, "--phi")
+    try:
+        pol: object = np.radians(float(polarization))
+    except ValueError:
+        pol = polarization
+    q = Quantity.parse(quantity, "--quantity")
+    TI, TR, PH = (a.reshape(-1) for a in np.meshgrid(ti, tr, ph, indexing="ij"))
+    f = m.evaluate(TI, TR, PH, quantity=q, polarization=pol)
+    w = sys.stdout
+    w.write(f"theta_i_deg,theta_r_deg,phi_deg,{quantity}\n")
+    for a, b, c, v in zip(np.degrees(TI), np.degrees(TR), np.degrees(PH), np.atleast_1d(f),
+                          strict=True):
+        w.write(f"{a:.6g},{b:.6g},{c:.6g},{v:.10g}\n")

@@ -4,26 +4,45 @@ Writes ``fit.json`` (keys ``model``, ``file``, ``loss``, ``channels``: per chann
 ``params``, ``stderr``, ``success``, ``metrics`` with ``sigma``, ``rms_log``, ``chi2``, ``aic``,
 ``bic``, ``n_points``; more keys may follow; ``aperture``: null or the instrument aperture used,
 ``half_angle_deg``, ``half_angle_rad``, ``points``), ``report.txt`` and one ``fit_<channel>.png``
-per channel into DIR. ``--aperture DEG`` compares each sample with the model averaged over a uniform
-cone of that half-angle (degrees) about the measured reflection direction (``rb.fit(...,
-aperture=radians)``). DIR may exist: files roughbrdf wrote there before are replaced, any other file
-of the same name is left alone and the command stops (``--force`` overrides); see
-:mod:`roughbrdf._outdir`. ``--free-scale`` fits a closed-form scale ``K`` of the data also for
+per channel into DIR, as one set (:class:`roughbrdf.output.ResultFolder`): DIR may exist, but a
+folder that holds results already, or a file of a name the run would write, stops the command
+before the fit (``--force`` replaces an earlier run's results, never a file roughbrdf did not
+write). ``--aperture DEG`` compares each sample with the model averaged over a uniform cone of
+that half-angle (degrees) about the measured reflection direction (``rb.fit(...,
+aperture=radians)``). ``--free-scale`` fits a closed-form scale ``K`` of the data also for
 absolute data (``rb.fit(..., free_scale=True)``), ``--no-plots`` skips the figures (and
-Matplotlib).
+Matplotlib). ``--bounds NAME=LOW:HIGH`` overrides a parameter's search range; ``--angles-in``
+states the angle unit of an ASTM or CSV file that does not.
+
+Exit status 1 when the fit did not converge for some channel (the results are written).
 """
 
 from __future__ import annotations
 
+import errno
 import math
+from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from .common import parse_params
+from .common import handled, parse_params
 
 if TYPE_CHECKING:
+    from ..measurement import Measurement
     from ..models import Model
+
+#: the library's argument names -> this verb's options (errors name the options)
+OPTIONS = {"model": "--model", "fix": "--fix", "bounds": "--bounds", "channel": "--channel",
+           "loss": "--loss", "starts": "--starts", "quantity": "--quantity",
+           "relative_to": "--relative-to", "format": "--format", "angles": "--angles-in",
+           "nonfinite": "--nonfinite", "negative": "--negative", "seed": "--seed",
+           "free_scale": "--free-scale", "aperture": "--aperture", "out_dir": "--out",
+           "overwrite": "--force", "plots": "--plots/--no-plots"}
+
+#: spellings of --angles-in -> the readers' angles= option
+ANGLE_UNITS = {"deg": "deg", "degree": "deg", "degrees": "deg", "rad": "rad", "radian": "rad",
+               "radians": "rad"}
 
 
 def build_model(spec: str, params: dict[str, Any] | None = None) -> Model:
@@ -40,6 +59,149 @@ def resolve_names(model: Model, names: list[str]) -> list[str]:
     return _models.resolve_names(model, names)
 
 
+def parse_bounds(model: Model, items: list[str] | None) -> dict[str, tuple[float, float]]:
+    """``--bounds NAME=LOW:HIGH`` (repeatable) -> ``{parameter: (low, high)}`` for ``rb.fit``.
+
+    Names are resolved like ``--fix`` (plain names allowed in sums).
+
+    Examples
+    --------
+    >>> import roughbrdf as rb
+    >>> parse_bounds(rb.model("tr75+lambertian"), ["e=0.1:2", "lambertian_rho=0:0.5"])
+    {'tr75_e': (0.1, 2.0), 'lambertian_rho': (0.0, 0.5)}
+    """
+    out: dict[str, tuple[float, float]] = {}
+    for item in items or []:
+        name, sep, rng = item.partition("=")
+        parts = rng.split(":")
+        try:
+            if not sep or len(parts) != 2:
+                raise ValueError
+            low, high = float(parts[0]), float(parts[1])
+        except ValueError:
+            raise ValueError(f"--bounds expects NAME=LOW:HIGH (e.g. --bounds e=0.1:2), got "
+                             f"{item!r}") from None
+        if not (math.isfinite(low) and math.isfinite(high) and low < high):
+            raise ValueError(f"--bounds {item}: need finite LOW < HIGH")
+        (key,) = resolve_names(model, [name.strip()])
+        out[key] = (low, high)
+    return out
+
+
+def start_within(model: Model, ranges: dict[str, tuple[float, float]],
+                 given: dict[str, Any]) -> Model:
+    """``model`` with each default starting value that ``--bounds`` excludes moved to the middle
+    of its range; a value the user gave (``-p``) is left for the fit to reject.
+
+    Examples
+    --------
+    >>> import roughbrdf as rb
+    >>> start_within(rb.model("tr75"), {"e": (1.0, 2.0)}, {}).params["e"]
+    1.5
+    """
+    mine = set()
+    for key in given:
+        try:
+            mine.update(resolve_names(model, [key]))
+        except ValueError:  # an option (distribution=...), not a parameter
+            continue
+    move = {name: 0.5 * (low + high) for name, (low, high) in ranges.items()
+            if name not in mine and model.params.get(name) is not None
+            and not low <= float(model.params[name]) <= high}
+    return model.with_values(list(move), list(move.values())) if move else model
+
+
+def angle_unit(text: str | None) -> str | None:
+    """``--angles-in`` -> the readers' ``angles=`` value (``"deg"``/``"rad"``), or None."""
+    if text is None:
+        return None
+    unit = ANGLE_UNITS.get(text.strip().lower())
+    if unit is None:
+        raise ValueError(f"--angles-in must be deg or rad, got {text!r}")
+    return unit
+
+
+def read_input(file: str, file_format: str | None, quantity: str | None,
+               angles: str | None) -> Measurement:
+    """The measurement FILE with the verb's reading options (``--format``, ``--quantity``,
+    ``--angles-in``), each checked in CLI terms first."""
+    from .. import io as _io
+    from ..quantity import Quantity
+
+    if not Path(file).exists():
+        raise FileNotFoundError(errno.ENOENT, "no such file", file)
+    opts: dict[str, Any] = {}
+    if quantity:
+        opts["quantity"] = Quantity.parse(quantity, "--quantity").value
+    unit = angle_unit(angles)
+    if unit is not None:
+        fmt = _io.format_for(file, file_format)
+        if fmt not in ("astm", "csv"):
+            raise ValueError(f"--angles-in applies to ASTM and CSV files; {fmt.upper()} files "
+                             f"are always in radians")
+        opts["angles"] = unit
+    if quantity and _io.format_for(file, file_format) == "merl":
+        raise ValueError("--quantity does not apply to MERL files (always BRDF)")
+    return _io.read(file, format=file_format, **opts)
+
+
+def result_names(meas: Measurement, channel: list[str] | None, plots: bool) -> list[str]:
+    """The files the run will write (``FitResult.save``: ``fit.json``, ``report.txt``,
+    ``fit_<channel>.png`` as :meth:`roughbrdf.FitResult.plot_names` names them)."""
+    labels = ([meas.channels[meas.channel_index(c)] for c in channel] if channel
+              else list(meas.channels))
+    names = ["fit.json", "report.txt"]
+    if plots:
+        for label in labels:
+            safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in label)
+            names.append(f"fit_{safe or 'channel'}.png")
+    return names
+
+
+def check_aperture(aperture: float | None) -> float | None:
+    """``--aperture DEG`` -> radians (None: no aperture); a clear error outside [0, 90)."""
+    if aperture is None:
+        return None
+    if not (math.isfinite(aperture) and 0 <= aperture < 90):
+        raise ValueError(f"--aperture must be a half-angle in degrees, 0 <= DEG < 90; got "
+                         f"{aperture!r}")
+    return math.radians(aperture)
+
+
+def run_fit(file: str, model: str, out: str, *, param: list[str] | None,
+            fix: list[str] | None, bounds: list[str] | None, channel: list[str] | None,
+            angles_in: str | None, quantity: str | None, file_format: str | None,
+            aperture: float | None, plots: bool, force: bool, quiet: bool,
+            **fit_options: Any) -> int:
+    """The work of ``roughbrdf fit``; returns the exit status (0, or 1 if not converged).
+
+    Everything that can be checked is checked before the fit: the options, the input file,
+    and that ``out`` may receive the results (:meth:`roughbrdf.output.ResultFolder.check`).
+    """
+    from ..fitting import fit
+    from ..output import ResultFolder
+
+    ap = check_aperture(aperture)
+    given = parse_params(param)
+    m = build_model(model, given)
+    fixed = resolve_names(m, list(fix or []))
+    ranges = parse_bounds(m, bounds)
+    m = start_within(m, ranges, given)
+    meas = read_input(file, file_format, quantity, angles_in)
+    chans = list(channel) if channel else None
+    ResultFolder(out, overwrite=force).check(result_names(meas, chans, plots))
+    # labels or positions as text; Measurement.channel_index resolves both ("525" also finds
+    # "525nm")
+    res = fit(m, meas, channel=chans, fix=fixed, bounds=ranges or None, aperture=ap,
+              progress=None if not quiet else False, **fit_options)
+    written = res.save(out, plots=plots, overwrite=force)
+    if not quiet:
+        typer.echo(res.report())
+        typer.echo("")
+    typer.echo("wrote " + ", ".join(str(p) for p in written))
+    return 0 if res.success else 1
+
+
 def register(app: typer.Typer) -> None:
     @app.command("fit")
     def fit_cmd(
@@ -47,18 +209,27 @@ def register(app: typer.Typer) -> None:
                                              ".binary)"),
         model: str = typer.Option(..., "--model", "-m",
                                   help="model name or sum, e.g. trowbridge-reitz-1975 or "
-                                       "microfacet+lambertian"),
-        out: str = typer.Option(..., "--out", "-o", help="output folder"),
+                                       "microfacet+lambertian (aliases: roughbrdf models)"),
+        out: str = typer.Option(..., "--out", "-o", help="output folder (refused if it holds "
+                                                          "results, unless --force)"),
         param: Annotated[list[str] | None, typer.Option(
             "-p", "--param", help="starting value or option, name=value (repeatable)")] = None,
         fix: Annotated[list[str] | None, typer.Option(
             "--fix", help="keep this parameter at its value (repeatable)")] = None,
+        bounds: Annotated[list[str] | None, typer.Option(
+            "--bounds", metavar="NAME=LOW:HIGH",
+            help="search range of a parameter, e.g. e=0.1:2 (repeatable; names as for "
+                 "--fix; a default starting value outside it starts in the middle)")] = None,
         channel: Annotated[list[str] | None, typer.Option(
             "--channel", "-c", help="channel label or index (repeatable; default: all)")] = None,
         loss: str = typer.Option("relative", help="relative ((x-f)/f, TR75), log or absolute"),
         starts: int = typer.Option(8, help="multistart points per channel"),
-        quantity: str = typer.Option(None, help="what the file's values are, if the file does "
-                                                "not say: brdf, brdf_cos, bridf or relative"),
+        quantity: str = typer.Option(None, help="input: what the file's values are, if the "
+                                                "file does not say: brdf, brdf_cos (= bridf), "
+                                                "bridf or relative"),
+        angles_in: str = typer.Option(None, "--angles-in", metavar="deg|rad",
+                                      help="input: angle unit of an ASTM or CSV file, "
+                                           "overriding the file"),
         relative_to: str = typer.Option(None, "--relative-to",
                                         help="for relative data: brdf or bridf (default: the "
                                              "file's relative_to, else brdf)"),
@@ -76,38 +247,17 @@ def register(app: typer.Typer) -> None:
                                             "model is averaged over it (default: none)"),
         plots: bool = typer.Option(True, "--plots/--no-plots", help="write PNG plots"),
         force: bool = typer.Option(False, "--force",
-                                   help="overwrite files of the same name not written by "
-                                        "roughbrdf"),
+                                   help="replace the results of an earlier run in --out (files "
+                                        "roughbrdf did not write are never replaced)"),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="no report on the terminal"),
     ) -> None:
         """Fit a model to a measurement file; write fit.json, report.txt and plots into --out."""
-        from .. import io as _io
-        from ..fitting import fit
-
-        try:
-            if aperture is not None and not (math.isfinite(aperture) and 0 <= aperture < 90):
-                raise ValueError(f"--aperture must be a half-angle in degrees, 0 <= DEG < 90; "
-                                 f"got {aperture!r}")
-            m = build_model(model, parse_params(param))
-            fixed = resolve_names(m, list(fix or []))
-            opts: dict[str, Any] = {}
-            if quantity:
-                opts["quantity"] = quantity
-            meas = _io.read(file, format=file_format, **opts)
-            # labels or positions as text; Measurement.channel_index resolves both ("525" also
-            # finds "525nm")
-            res = fit(m, meas, channel=list(channel) if channel else None, loss=loss, fix=fixed,
-                      starts=starts, seed=seed, free_scale=free_scale,
-                      nonfinite=nonfinite, negative=negative, relative_to=relative_to,
-                      aperture=None if aperture is None else math.radians(aperture),
-                      progress=None if not quiet else False)
-            written = res.save(out, plots=plots, force=force)
-        except (ValueError, FileNotFoundError, FileExistsError, TypeError) as exc:
-            typer.echo(f"error: {exc}", err=True)
-            raise typer.Exit(2) from exc
-        if not quiet:
-            typer.echo(res.report())
-            typer.echo("")
-        typer.echo("wrote " + ", ".join(str(p) for p in written))
-        if not res.success:
-            raise typer.Exit(1)
+        with handled(OPTIONS):
+            code = run_fit(file, model, out, param=param, fix=fix, bounds=bounds,
+                           channel=channel, angles_in=angles_in, quantity=quantity,
+                           file_format=file_format, aperture=aperture, plots=plots,
+                           force=force, quiet=quiet, loss=loss, starts=starts, seed=seed,
+                           free_scale=free_scale, nonfinite=nonfinite, negative=negative,
+                           relative_to=relative_to)
+        if code:
+            raise typer.Exit(code)

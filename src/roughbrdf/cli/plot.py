@@ -1,7 +1,18 @@
-"""``roughbrdf plot``: plot a model (in-plane, polar or hemisphere) or a fit's comparison."""
+"""``roughbrdf plot``: plot a model (in-plane, polar or hemisphere) or a fit's comparison.
+
+``--out FILE.png`` is written atomically and never replaces a file unless ``--force``
+(:func:`roughbrdf.output.atomic_write`). ``--fit DIR`` without ``--out`` adds
+``comparison_<channel>.png`` to the fit's results in DIR (:class:`roughbrdf.output.ResultFolder`
+with ``extend=True``: a later ``roughbrdf fit --force`` into DIR replaces them with the rest).
+The measurement of the fit is found from any folder (``fit.json``'s ``file``, else
+``file_abspath``, else ``file`` beside ``fit.json``); a warning says when it has changed since
+the fit (``file_sha256``).
+"""
 
 from __future__ import annotations
 
+import errno
+import hashlib
 import json
 import math
 import re
@@ -10,21 +21,39 @@ from typing import Annotated, Any
 
 import typer
 
-from .common import degree_range, parse_params
+from .common import degree_range, handled, parse_params
 
 KINDS = ("in-plane", "polar", "hemisphere")
 
-
-def _fail(msg: str) -> typer.Exit:
-    typer.echo(f"error: {msg}", err=True)
-    return typer.Exit(2)
+#: the library's argument names -> this verb's options (errors name the options)
+OPTIONS = {"theta_i": "--theta-i", "elevation": "--elevation", "quantity": "--quantity",
+           "kind": "--kind", "log": "--log/--linear", "channel": "--channel",
+           "overwrite": "--force", "path": "--out"}
 
 
 def _check_out(path: Path, force: bool) -> None:
+    from ..output import OverwriteRefused
+
+    if path.is_dir():
+        raise IsADirectoryError(errno.EISDIR, "a folder; --out names the PNG file to write",
+                                str(path))
     if path.suffix.lower() != ".png":
         raise ValueError(f"--out must be a .png file, got {str(path)!r}")
     if path.exists() and not force:
-        raise FileExistsError(f"{path} exists; use --force to overwrite")
+        raise OverwriteRefused(path, single=True)
+
+
+def _png(fig: Any, dpi: int = 100) -> Any:
+    """A writer of ``fig`` as PNG into an open binary file."""
+    return lambda fh: fig.savefig(fh, format="png", dpi=dpi)
+
+
+def _write_png(fig: Any, path: Path, force: bool) -> Path:
+    """``fig`` to ``path`` atomically (the folder is created if needed)."""
+    from ..output import atomic_write, ensure_folder
+
+    ensure_folder(path.parent if str(path.parent) else Path("."))
+    return atomic_write(path, _png(fig), overwrite=force, binary=True)
 
 
 def _model_figure(model_name: str, params: dict[str, Any], kind: str, theta_i: str,
@@ -84,17 +113,49 @@ def _fit_aperture(fit: dict[str, Any]):
     return Aperture.parse(ap["half_angle_rad"], ap.get("points", 19))
 
 
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _input_file(fit: dict[str, Any], base: Path) -> tuple[Path, bool]:
+    """The fit's measurement file and whether it has changed since the fit.
+
+    ``file`` as recorded (relative to the current folder), else ``file_abspath``, else ``file``
+    beside fit.json; with ``file_sha256`` the first candidate whose contents match wins.
+    """
+    given = Path(str(fit["file"]))
+    candidates = [given]
+    if not given.is_absolute():
+        if fit.get("file_abspath"):
+            candidates.append(Path(str(fit["file_abspath"])))
+        candidates.append(base / given)
+    found = [c for c in dict.fromkeys(candidates) if c.is_file()]
+    if not found:
+        raise FileNotFoundError(f"measurement file {fit['file']!r} of the fit not found "
+                                f"(looked in {', '.join(str(c) for c in candidates)})")
+    digest = fit.get("file_sha256")
+    if not digest:
+        return found[0], False  # a fit.json of an older roughbrdf
+    for c in found:
+        if _sha256(c) == digest:
+            return c, False
+    return found[0], True
+
+
 def _fit_measurement(fit: dict[str, Any], base: Path):
     from dataclasses import replace
 
     from .. import io as rbio
 
-    file = Path(fit["file"])
-    candidates = [file] if file.is_absolute() else [file, base / file]
-    path = next((c for c in candidates if c.exists()), None)
-    if path is None:
-        raise FileNotFoundError(f"measurement file {fit['file']!r} of the fit not found "
-                                f"(looked in {', '.join(str(c) for c in candidates)})")
+    path, changed = _input_file(fit, base)
+    if changed:
+        typer.echo(f"warning: {path} has changed since the fit (its SHA-256 differs from "
+                   f"fit.json's file_sha256); plotting the fit against the file as it is now",
+                   err=True)
     try:
         meas = rbio.read(path)
     except ValueError:
@@ -111,14 +172,9 @@ def _safe(label: str) -> str:
     return re.sub(r"[^A-Za-z0-9._-]+", "_", str(label)) or "channel"
 
 
-def _fit_figures(fit_dir: Path, out: Path | None, channel: str | None, force: bool
-                 ) -> list[Path]:
-    from matplotlib.figure import Figure
-
-    from .. import plot as rbplot
-
-    fit, base = _read_fit(fit_dir)
-    meas = _fit_measurement(fit, base)
+def _fit_channels(fit: dict[str, Any], channel: str | None, out: Path | None
+                  ) -> list[dict[str, Any]]:
+    """The channels of ``fit`` to draw (``--channel``), checked against ``--out``."""
     chans = fit["channels"]
     if channel is not None:
         chans = [c for i, c in enumerate(chans) if str(c.get("channel")) == channel
@@ -129,27 +185,51 @@ def _fit_figures(fit_dir: Path, out: Path | None, channel: str | None, force: bo
     if out is not None and len(chans) > 1:
         raise ValueError("--out names one file but the fit has several channels; pick one with "
                          "--channel or omit --out (files go into the fit directory)")
-    targets = []
-    for c in chans:
-        target = out if out is not None else base / f"comparison_{_safe(c.get('channel'))}.png"
-        _check_out(target, force)
-        targets.append(target)
+    return chans
+
+
+def _fit_figure(fit: dict[str, Any], fit_dir: Path, meas: Any, chan: dict[str, Any],
+                aperture: Any) -> Any:
+    """Data vs model and the residual map of one channel of the fit."""
+    from matplotlib.figure import Figure
+
+    from .. import plot as rbplot
+
+    model = _fit_model(fit, chan)
+    label = chan.get("channel")
+    ch = meas.channel_index(label) if str(label) in meas.channels else 0
+    fig = Figure(figsize=(13, 5.2), layout="constrained")
+    ax1 = fig.add_subplot(1, 2, 1)
+    ax2 = fig.add_subplot(1, 2, 2)
+    rbplot.plot_comparison(model, meas, channel=ch, ax=ax1, aperture=aperture)
+    rbplot.plot_residual_map(model, meas, channel=ch, ax=ax2, aperture=aperture)
+    fig.suptitle(f"fit {fit_dir}: {fit['model']} to {Path(str(fit['file'])).name} "
+                 f"[{label}], loss {fit.get('loss', '?')}", fontsize="medium")
+    return fig
+
+
+def _fit_figures(fit_dir: Path, out: Path | None, channel: str | None, force: bool
+                 ) -> list[Path]:
+    """Draw the comparison of each channel of the fit in ``fit_dir``: into ``out``, or added to
+    the fit's results in its folder; everything is checked before the drawing."""
+    from ..output import ResultFolder
+
+    fit, base = _read_fit(fit_dir)
+    chans = _fit_channels(fit, channel, out)
+    if out is not None:
+        _check_out(out, force)
+        meas = _fit_measurement(fit, base)
+        fig = _fit_figure(fit, fit_dir, meas, chans[0], _fit_aperture(fit))
+        return [_write_png(fig, out, force)]
+    names = [f"comparison_{_safe(str(c.get('channel')))}.png" for c in chans]
+    folder = ResultFolder(base, overwrite=force, extend=True)
+    folder.check(names)
+    meas = _fit_measurement(fit, base)
     aperture = _fit_aperture(fit)
-    written = []
-    for c, target in zip(chans, targets, strict=True):
-        model = _fit_model(fit, c)
-        label = c.get("channel")
-        ch = meas.channel_index(label) if str(label) in meas.channels else 0
-        fig = Figure(figsize=(13, 5.2), layout="constrained")
-        ax1 = fig.add_subplot(1, 2, 1)
-        ax2 = fig.add_subplot(1, 2, 2)
-        rbplot.plot_comparison(model, meas, channel=ch, ax=ax1, aperture=aperture)
-        rbplot.plot_residual_map(model, meas, channel=ch, ax=ax2, aperture=aperture)
-        fig.suptitle(f"fit {fit_dir}: {fit['model']} to {Path(str(fit['file'])).name} "
-                     f"[{label}], loss {fit.get('loss', '?')}", fontsize="medium")
-        fig.savefig(target, dpi=100)
-        written.append(target)
-    return written
+    with folder:
+        for c, name in zip(chans, names, strict=True):
+            folder.add(name, _png(_fit_figure(fit, fit_dir, meas, c, aperture)), binary=True)
+    return [base / n for n in names]
 
 
 def register(app: typer.Typer) -> None:
@@ -165,7 +245,9 @@ def register(app: typer.Typer) -> None:
                               "polar/hemisphere)")] = "0:60:20",
         elevation: Annotated[float, typer.Option(
             help="polar: reflection elevation (TR75 theta), DEG")] = 45.0,
-        quantity: Annotated[str, typer.Option(help="brdf, bridf or relative")] = "brdf",
+        quantity: Annotated[str, typer.Option(
+            help="output: the quantity plotted, brdf, brdf_cos (= bridf), bridf or relative "
+                 "(to the specular value)")] = "brdf",
         log: Annotated[bool | None, typer.Option(
             "--log/--linear", help="logarithmic value axis/colours")] = None,
         fit: Annotated[Path | None, typer.Option(
@@ -173,7 +255,9 @@ def register(app: typer.Typer) -> None:
                  "map")] = None,
         channel: Annotated[str | None, typer.Option(help="with --fit: one channel")] = None,
         out: Annotated[Path | None, typer.Option("--out", "-o", help="output PNG file")] = None,
-        force: Annotated[bool, typer.Option(help="overwrite an existing output file")] = False,
+        force: Annotated[bool, typer.Option(
+            help="replace an existing --out file, or the comparison figures of an earlier "
+                 "plot --fit")] = False,
     ) -> None:
         """Plot a model (MODEL -p name=value ...) or a fit (--fit DIR) to a PNG file.
 
@@ -184,28 +268,32 @@ def register(app: typer.Typer) -> None:
 
           roughbrdf plot --fit fitdir          (writes fitdir/comparison_<channel>.png)
         """
-        import matplotlib
+        with handled(OPTIONS):
+            import matplotlib
 
-        matplotlib.use("Agg")
-        try:
-            if fit is not None:
-                if model is not None:
-                    raise ValueError("give either MODEL or --fit DIR, not both")
-                for p in _fit_figures(fit, out, channel, force):
-                    typer.echo(f"wrote {p}")
-                return
-            if model is None:
-                raise ValueError("give a MODEL name (see `roughbrdf models`) or --fit DIR")
-            if out is None:
-                raise ValueError("--out FILE.png is required")
-            if kind not in KINDS:
-                raise ValueError(f"--kind must be one of {', '.join(KINDS)}, got {kind!r}")
-            if quantity not in ("brdf", "bridf", "relative"):
-                raise ValueError(f"--quantity must be brdf, bridf or relative, got {quantity!r}")
-            _check_out(out, force)
-            fig, _ax = _model_figure(model, parse_params(param), kind, theta_i, elevation,
-                                     quantity, log)
-            fig.savefig(out, dpi=100)
-            typer.echo(f"wrote {out}")
-        except (ValueError, FileExistsError, FileNotFoundError) as exc:
-            raise _fail(str(exc)) from exc
+            matplotlib.use("Agg")
+            for p in _plot(model, parse_params(param), kind, theta_i, elevation, quantity, log,
+                           fit, channel, out, force):
+                typer.echo(f"wrote {p}")
+
+
+def _plot(model: str | None, params: dict[str, Any], kind: str, theta_i: str, elevation: float,
+          quantity: str, log: bool | None, fit: Path | None, channel: str | None,
+          out: Path | None, force: bool) -> list[Path]:
+    """The work of ``roughbrdf plot``; returns the files written."""
+    from ..quantity import Quantity
+
+    if fit is not None:
+        if model is not None:
+            raise ValueError("give either MODEL or --fit DIR, not both")
+        return _fit_figures(fit, out, channel, force)
+    if model is None:
+        raise ValueError("give a MODEL name (see `roughbrdf models`) or --fit DIR")
+    if out is None:
+        raise ValueError("--out FILE.png is required")
+    if kind not in KINDS:
+        raise ValueError(f"--kind must be one of {', '.join(KINDS)}, got {kind!r}")
+    q = Quantity.parse(quantity, "--quantity").value
+    _check_out(out, force)
+    fig, _ax = _model_figure(model, params, kind, theta_i, elevation, q, log)
+    return [_write_png(fig, out, force)]

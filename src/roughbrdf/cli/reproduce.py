@@ -7,13 +7,22 @@ from typing import Annotated
 
 import typer
 
+from .common import handled
+
+#: the library's argument names -> this verb's options (errors name the options)
+OPTIONS = {"paper": "--paper", "out": "--out", "overwrite": "--force", "data_dir": "--data"}
+
 
 def register(app: typer.Typer) -> None:
     @app.command("reproduce")
     def reproduce_cmd(
-        out: Annotated[Path, typer.Option("--out", "-o", help="output directory (created)")],
+        out: Annotated[Path, typer.Option(
+            "--out", "-o", help="output folder (created; refused if it holds results, unless "
+                                "--force)")],
         paper: Annotated[str, typer.Option(help="ts67, tr75, rb08 or all")] = "all",
-        force: Annotated[bool, typer.Option(help="overwrite existing files")] = False,
+        force: Annotated[bool, typer.Option(
+            help="replace the results of an earlier run in --out (files roughbrdf did not "
+                 "write are never replaced)")] = False,
         compact: Annotated[bool, typer.Option(
             help="256-colour palette PNGs (smaller files)")] = False,
         data: Annotated[Path | None, typer.Option(
@@ -25,15 +34,15 @@ def register(app: typer.Typer) -> None:
         Every plotted or printed number comes from the library's public API; each figure is
         written with the CSV of the numbers behind it. See docs/reproduction.md.
         """
-        import matplotlib
+        with handled(OPTIONS):
+            import matplotlib
 
-        matplotlib.use("Agg")
-        from .. import reproduce
+            matplotlib.use("Agg")
+            from .. import reproduce
 
-        try:
-            paths = reproduce.run(paper, out, force=force, compact=compact, data_dir=data,
-                                   echo=typer.echo)
-        except (ValueError, FileExistsError, FileNotFoundError, reproduce.Unavailable) as exc:
-            typer.echo(f"error: {exc}", err=True)
-            raise typer.Exit(2) from exc
+            try:
+                paths = reproduce.run(paper, out, overwrite=force, compact=compact,
+                                      data_dir=data, echo=typer.echo)
+            except reproduce.Unavailable as exc:  # the user's to fix (e.g. --data): status 2
+                raise ValueError(str(exc)) from exc
         typer.echo(f"{len(paths)} files written to {out}")

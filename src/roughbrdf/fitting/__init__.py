@@ -40,7 +40,7 @@ from ..instrument import APERTURE_POINTS, Aperture, aperture_average, aperture_s
 from ..quantity import LOSSES
 from .data import ChannelData, Comparison, DataOptions, prepare_channel
 from .objective import Objective, ObjectiveSpec
-from .result import ChannelFit, FitResult
+from .result import ChannelFit, FitResult, input_source
 from .search import MultiStart, SearchOptions, progress_bar
 from .setup import (
     FreeParameters,
@@ -94,7 +94,8 @@ def fit(model: Model | str, measurement: Measurement, *,
     bounds : dict, optional
         ``name -> (low, high)``, overriding the model's default search ranges.
     starts : int
-        Local fits per channel: one from the model's values, then ``starts - 1`` from Sobol
+        Local fits per channel, exactly: one from the model's values, one from the previous
+        channel's optimum (channels after the first, ``starts >= 2``), the rest from Sobol
         points in the bounds (``starts=1`` is a plain local fit from the model's values).
     screen : int
         Number of Sobol points in the bounds whose cost is evaluated (one model evaluation
@@ -145,7 +146,11 @@ def fit(model: Model | str, measurement: Measurement, *,
     ValueError
         Unknown loss or option, every parameter fixed, no data left in a channel, non-finite
         values with ``nonfinite="raise"``, non-positive values for the log loss with
-        ``negative="keep"``, an aperture that is negative, not finite or >= pi/2.
+        ``negative="keep"``, an aperture that is negative, not finite or >= pi/2, bounds that
+        do not contain the starting value or leave a parameter's physical domain. Errors
+        about an argument are :class:`~roughbrdf.errors.ArgumentError` (naming the argument,
+        the value and, where there is one, the fix; ``err.render(options)`` words them for
+        the command line).
     """
     t_start = time.perf_counter()
     model = as_model(model)
@@ -184,4 +189,5 @@ def fit(model: Model | str, measurement: Measurement, *,
                      relative_to=opts.comparison.relative_to, options=options,
                      elapsed=time.perf_counter() - t_start,
                      aperture=None if ap is None else ap.half_angle,
-                     aperture_points=int(aperture_points))
+                     aperture_points=19 if ap is None else ap.points,
+                     source=input_source(measurement))

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..errors import ArgumentError
 from ..instrument import Aperture, InstrumentGeometry
 from ..quantity import LOSSES, Quantity
 
@@ -102,8 +103,9 @@ class Comparison:
         try:
             model_q = q.compared_with(rel)
         except ValueError as exc:  # an unknown name or "relative": say what relative_to means
-            raise ValueError(f"relative_to must be 'brdf' or 'bridf' (what the relative values "
-                             f"are proportional to), got {rel!r}") from exc
+            raise ArgumentError("relative_to", f"relative_to must be 'brdf' or 'bridf' (what "
+                                f"the relative values are proportional to), got {rel!r}"
+                                ) from exc
         return cls(model_q, model_q.value)
 
     @property
@@ -124,13 +126,15 @@ class DataOptions:
     aperture: Aperture | None = None
 
     def __post_init__(self) -> None:
-        if self.loss not in LOSSES:
-            raise ValueError(f"unknown loss {self.loss!r}; choose one of {', '.join(LOSSES)}")
-        if self.nonfinite not in ("raise", "drop"):
-            raise ValueError(f"nonfinite must be 'raise' or 'drop', got {self.nonfinite!r}")
-        if self.negative not in ("keep", "drop", "clip"):
-            raise ValueError(f"negative must be 'keep', 'drop' or 'clip', got "
-                             f"{self.negative!r}")
+        if not isinstance(self.loss, str) or self.loss not in LOSSES:
+            raise ArgumentError("loss", f"unknown loss {self.loss!r}; choose one of "
+                                f"{', '.join(LOSSES)}")
+        if not isinstance(self.nonfinite, str) or self.nonfinite not in ("raise", "drop"):
+            raise ArgumentError("nonfinite", f"nonfinite must be 'raise' or 'drop', got "
+                                f"{self.nonfinite!r}")
+        if not isinstance(self.negative, str) or self.negative not in ("keep", "drop", "clip"):
+            raise ArgumentError("negative", f"negative must be 'keep', 'drop' or 'clip', got "
+                                f"{self.negative!r}")
 
 
 # --------------------------------------------------------------------------------------------
@@ -213,22 +217,32 @@ def channel_weights(weights: Any, meas: Measurement, j: int, x: np.ndarray, loss
         return None
     if isinstance(weights, str):
         if weights != "uncertainty":
-            raise ValueError(f"weights must be None, an array or 'uncertainty', got {weights!r}")
+            raise ArgumentError("weights", f"weights must be None, an array or 'uncertainty', "
+                                f"got {weights!r}")
         if meas.uncertainty is None:
-            raise ValueError("weights='uncertainty' but the measurement has no uncertainty")
+            raise ArgumentError("weights", "weights='uncertainty' but the measurement has no "
+                                "uncertainty")
         u = meas.uncertainty[:, j]
         with np.errstate(divide="ignore", invalid="ignore"):
             w = 1.0 / u if loss == "absolute" else np.abs(x) / u
         return np.where(np.isfinite(w) & (u > 0), w, 0.0)
-    w = np.asarray(weights, dtype=float)
+    try:
+        w = np.asarray(weights, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise ArgumentError("weights", "weights must be None, an array of numbers or "
+                            "'uncertainty'") from None
     if w.ndim == 2:
         if w.shape != meas.values.shape:
-            raise ValueError(f"weights of shape {w.shape} do not match the values "
-                             f"{meas.values.shape}")
+            raise ArgumentError("weights", f"weights of shape {w.shape} do not match the values "
+                                f"{meas.values.shape}")
         w = w[:, j]
-    w = np.broadcast_to(w, (meas.n_samples,)).astype(float)
+    try:
+        w = np.broadcast_to(w, (meas.n_samples,)).astype(float)
+    except ValueError:
+        raise ArgumentError("weights", f"weights of shape {w.shape} do not match the "
+                            f"{meas.n_samples} samples") from None
     if not np.all(np.isfinite(w)) or np.any(w < 0):
-        raise ValueError("weights must be finite and >= 0")
+        raise ArgumentError("weights", "weights must be finite and >= 0")
     return w
 
 
@@ -242,8 +256,8 @@ def _bad_values(x: np.ndarray, keep: np.ndarray, excluded: dict[str, int],
         if opts.nonfinite == "raise":
             rows = np.flatnonzero(bad)
             show = ", ".join(str(r) for r in rows[:8]) + (" ..." if rows.size > 8 else "")
-            raise ValueError(f"{place}: {rows.size} non-finite value(s) at sample(s) {show}; "
-                             f"pass nonfinite='drop' to fit without them")
+            raise ArgumentError("nonfinite", f"{place}: {rows.size} non-finite value(s) at "
+                                f"sample(s) {show}, which cannot be fitted", fix="drop")
         keep &= ~bad
         excluded["nonfinite"] = int(bad.sum())
     log = opts.loss == "log"
@@ -252,9 +266,9 @@ def _bad_values(x: np.ndarray, keep: np.ndarray, excluded: dict[str, int],
         return
     if opts.negative == "keep":
         if log:
-            raise ValueError(f"{place}: the log loss needs positive values but "
-                             f"{int(neg.sum())} are <= 0; pass negative='drop' or "
-                             f"negative='clip'")
+            raise ArgumentError("negative", f"{place}: the log loss needs positive values but "
+                                f"{int(neg.sum())} are <= 0 (drop them, or clip them to the "
+                                f"smallest positive value with 'clip')", fix="drop")
     elif opts.negative == "drop":
         keep &= ~neg
         excluded["negative"] = int(neg.sum())

@@ -235,11 +235,13 @@ class Objective:
             out[:, j] = (self.residual_of(self.values(t), k) - r0) / h
         return out
 
-    def jac_central(self, theta: np.ndarray, k: float) -> np.ndarray:
+    def jac_central(self, theta: np.ndarray, k: float,
+                    columns: Sequence[int] | None = None) -> np.ndarray:
         """Central-difference Jacobian at fixed scale ``k`` (for the covariance); one-sided
-        next to a bound."""
-        out = np.empty((self.n, theta.size))
-        for j in range(theta.size):
+        next to a bound. ``columns``: only those free parameters (default all), in order."""
+        cols = range(theta.size) if columns is None else list(columns)
+        out = np.empty((self.n, len(cols)))
+        for c, j in enumerate(cols):
             h = abs(self._step(theta, j, CENTRAL_STEP))
             lo_ok = theta[j] - h >= self.spec.lower[j]
             hi_ok = theta[j] + h <= self.spec.upper[j]
@@ -254,7 +256,7 @@ class Objective:
             else:
                 tm[j] -= h
                 d = h
-            out[:, j] = (self.residual_of(self.values(tp), k)
+            out[:, c] = (self.residual_of(self.values(tp), k)
                          - self.residual_of(self.values(tm), k)) / d
         return out
 

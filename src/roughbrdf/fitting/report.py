@@ -6,6 +6,11 @@ then per channel: success and message, points (and what was left out, with the r
 reduced chi2, AIC, BIC, TR75's sigma (Eq. 34) and the r.m.s. log residual, the parameters with
 their standard errors, initial values and bounds, the scale ``K``, and the correlations above
 ``min_correl``. ``docs/fitting.md`` shows an example.
+
+Honest at bounds: a parameter at a bound (:func:`~roughbrdf.fitting.statistics.at_bound`) is
+printed ``(at the lower bound: no stderr)`` with a note why (the covariance is not meaningful
+at an active bound); a relative error is printed as a percentage only up to 1000 %
+(:func:`percent`); ``# starts`` is the number of local fits run, which is the number asked.
 """
 
 from __future__ import annotations
@@ -18,7 +23,7 @@ from .data import excluded_text
 if TYPE_CHECKING:
     from .result import ChannelFit, FitResult
 
-__all__ = ["report", "fmt"]
+__all__ = ["report", "fmt", "percent", "MAX_PERCENT_RATIO"]
 
 _LOSS_TEXT = {"relative": "relative, (x - f)/f  (TR75 Eq. 34)",
               "log": "log, ln x - ln f", "absolute": "absolute, x - f"}
@@ -65,8 +70,19 @@ def _header(result: FitResult) -> list[str]:
             f"    time               = {result.elapsed:.3g} s"]
 
 
+def _starts_text(c: ChannelFit) -> str:
+    """The local fits run: the starts (as asked), where they came from, and the polish."""
+    explored = [s for s in c.starts if s["stage"] != "full"]
+    polished = len(c.starts) - len(explored)
+    notes = []
+    if any(s.get("origin") == "previous channel" for s in explored):
+        notes.append("1 from the previous channel's optimum")
+    if polished:
+        notes.append(f"on a subsample, the {polished} best refined on all samples")
+    return f"{len(explored)}" + (f"  ({'; '.join(notes)})" if notes else "")
+
+
 def _channel(c: ChannelFit) -> list[str]:
-    nst = len([s for s in c.starts if s["stage"] != "full"])
     return [
         f"[[Channel {c.channel}]]",
         f"    success            = {c.success}  ({c.message})",
@@ -74,7 +90,7 @@ def _channel(c: ChannelFit) -> list[str]:
         f"{excluded_text(c.excluded)})",
         f"    # variables        = {c.n_varys}"
         + ("  (including the scale K)" if c.free_scale else ""),
-        f"    # starts           = {nst}",
+        f"    # starts           = {_starts_text(c)}",
         f"    # model evals      = {c.nfev}",
         f"    chi-square         = {fmt(c.chi2)}",
         f"    reduced chi-square = {fmt(c.redchi)}",
@@ -85,24 +101,49 @@ def _channel(c: ChannelFit) -> list[str]:
     ]
 
 
+#: relative standard errors above this (1000 %) are not printed as a percentage
+MAX_PERCENT_RATIO = 10.0
+
+
+def percent(se: float | None, val: float | None) -> str:
+    """``" (1.23%)"``: the standard error relative to the value, or ``""`` when it is not
+    meaningful (no stderr, value 0), or ``" (> 1000%)"`` beyond :data:`MAX_PERCENT_RATIO`.
+
+    Examples
+    --------
+    >>> percent(0.01, 0.5), percent(5.43e5, 5.6e-13), percent(float("nan"), 1.0), percent(1, 0)
+    (' (2.00%)', ' (> 1000%)', '', '')
+    """
+    if se is None or val is None or not math.isfinite(se) or not val:
+        return ""
+    ratio = se / abs(val)
+    return f" ({100 * ratio:.2f}%)" if ratio <= MAX_PERCENT_RATIO else " (> 1000%)"
+
+
 def _variable(c: ChannelFit, name: str, val: float | None) -> str:
     if name not in c.free:
         return "None (switched off)" if val is None else f"{fmt(val, 7)} (fixed)"
-    se = c.stderr.get(name)
-    pct = (f" ({100 * se / abs(val):.2f}%)"
-           if se is not None and math.isfinite(se) and val else "")
     lo, hi = c.bounds[name]
-    return (f"{fmt(val, 7)} +/- {fmt(se, 4)}{pct} (init = {fmt(c.init[name])}, "
-            f"bounds [{fmt(lo)}, {fmt(hi)}])")
+    tail = f"(init = {fmt(c.init[name])}, bounds [{fmt(lo)}, {fmt(hi)}])"
+    side = c.at_bound.get(name)
+    if side is not None:
+        return f"{fmt(val, 7)} (at the {side} bound: no stderr) {tail}"
+    se = c.stderr.get(name)
+    return f"{fmt(val, 7)} +/- {fmt(se, 4)}{percent(se, val)} {tail}"
 
 
 def _variables(c: ChannelFit) -> list[str]:
     width = max(len(n) for n in [*c.params, "scale K"])
     lines = ["[[Variables]]"]
     lines += [f"    {name:<{width}}: {_variable(c, name, val)}" for name, val in c.params.items()]
+    if c.at_bound:
+        names = ", ".join(c.at_bound)
+        lines += [f"    ({names} at a bound: no standard error, since the covariance is not "
+                  f"meaningful",
+                  f"     at an active bound; the others' are computed with {names} held there)"]
     if c.free_scale:
         lines.append(f"    {'scale K':<{width}}: {fmt(c.scale, 7)} +/- "
-                     f"{fmt(c.scale_stderr, 4)} (closed form)")
+                     f"{fmt(c.scale_stderr, 4)}{percent(c.scale_stderr, c.scale)} (closed form)")
     elif c.scale != 1.0:
         lines.append(f"    {'scale K':<{width}}: {fmt(c.scale, 7)} (given)")
     return lines

@@ -11,16 +11,20 @@ content
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
+import os
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any
+from pathlib import Path
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..instrument import Aperture, aperture_average
 from ..quantity import Quantity
-from .statistics import Covariance, GoodnessOfFit
+from .statistics import Covariance, GoodnessOfFit, at_bound
 
 if TYPE_CHECKING:
     from ..measurement import Measurement
@@ -28,7 +32,7 @@ if TYPE_CHECKING:
     from .objective import Objective
     from .search import SearchOutcome
 
-__all__ = ["ChannelFit", "FitResult"]
+__all__ = ["ChannelFit", "FitResult", "input_source"]
 
 
 @dataclass
@@ -50,11 +54,20 @@ class ChannelFit:
     bounds : dict
         ``name -> (low, high)`` used for the free parameters.
     stderr : dict
-        ``name -> standard error`` (``None`` for fixed parameters, ``nan`` if not estimable).
+        ``name -> standard error`` (``None`` for fixed parameters, ``nan`` if not estimable or
+        at a bound).
+    at_bound : dict
+        ``name -> "lower" | "upper"`` for the free parameters at (or within a relative
+        :data:`~roughbrdf.fitting.statistics.AT_BOUND_RTOL` of the width of their bounds from)
+        a bound. They have no standard error and no correlations: the covariance is not
+        meaningful at an active bound (it assumes the optimum is an interior minimum of the
+        cost; there the bound, not the data, sets the value). The other parameters' covariance
+        is computed with them held at the bound.
     correl : dict
         ``name -> {other: correlation}`` among the free parameters (and ``"scale"``).
     covar : numpy.ndarray
-        Covariance of ``free`` (+ ``scale`` last if it is free).
+        Covariance of ``free`` (+ ``scale`` last if it is free); NaN rows and columns for the
+        parameters at a bound.
     scale, scale_stderr : float
         The data scale ``K`` (``x -> K x``; 1 and 0 when the data are absolute).
     success : bool
@@ -74,7 +87,9 @@ class ChannelFit:
     nfev : int
         Model evaluations (each one vectorized over all samples of the stage).
     starts : list of dict
-        Every start: ``{"x0": ..., "cost": ..., "stage": "explore"|"full"|"single"}``.
+        Every local fit: ``{"x0", "x", "cost", "stage": "explore"|"full"|"single", "origin"}``
+        (:class:`~roughbrdf.fitting.search.SearchOutcome`); the ``stage != "full"`` ones are
+        the ``starts`` asked for, the ``"full"`` ones their polish on all samples.
     elapsed : float
         Seconds.
     index : numpy.ndarray
@@ -118,6 +133,7 @@ class ChannelFit:
     data: np.ndarray = field(repr=False)
     fitted: np.ndarray = field(repr=False)
     residual: np.ndarray = field(repr=False)
+    at_bound: dict[str, str] = field(default_factory=dict)
 
     @property
     def metrics(self) -> dict[str, float | int]:
@@ -137,14 +153,16 @@ class ChannelFit:
         r = obj.residual_of(f, k)
         gof = GoodnessOfFit.of(r, data.values, f, scale=k, n_varys=spec.n_varys,
                                floor=obj.floor)
-        cov = Covariance.at_optimum(obj, theta, f, k, chi2=gof.chi2, dof=gof.dof)
+        bound = at_bound(theta, spec.lower, spec.upper, spec.free)
+        cov = Covariance.at_optimum(obj, theta, f, k, chi2=gof.chi2, dof=gof.dof,
+                                    held=list(bound))
         sd = cov.stderr()
         stderr: dict[str, float | None] = dict.fromkeys(spec.model.param_names)
         stderr.update({nm: float(s) for nm, s in zip(cov.names, sd, strict=True)
                        if nm != "scale"})
         res = outcome.result
         message = (res.message.rstrip(".") if res is not None else "no local fit finished")
-        message += cov.note + _bound_note(theta, spec.lower, spec.upper, spec.free)
+        message += cov.note + (f"; at a bound: {', '.join(bound)}" if bound else "")
         return cls(
             channel=data.label, model=fitted_model, params=fitted_model.params,
             free=list(spec.free), init=spec.start_values(),
@@ -156,26 +174,19 @@ class ChannelFit:
             sigma=gof.sigma, rms_log=gof.rms_log, chi2=gof.chi2, redchi=gof.redchi,
             aic=gof.aic, bic=gof.bic, n_points=gof.n_points, n_varys=gof.n_varys,
             excluded=data.excluded, nfev=obj.nfev + outcome.explore_nfev, starts=outcome.tried,
-            free_scale=spec.free_scale, elapsed=elapsed, index=data.index, data=data.values,
-            fitted=f, residual=r)
+            free_scale=spec.free_scale, at_bound=bound, elapsed=elapsed, index=data.index,
+            data=data.values, fitted=f, residual=r)
 
     def to_dict(self) -> dict[str, Any]:
         """This channel's entry of ``fit.json`` (before NaN -> null)."""
         return {"channel": self.channel, "params": self.params, "stderr": self.stderr,
-                "success": bool(self.success), "metrics": self.metrics,
+                "at_bound": self.at_bound, "success": bool(self.success),
+                "metrics": self.metrics,
                 "message": self.message, "free": self.free, "init": self.init,
                 "bounds": {k: list(v) for k, v in self.bounds.items()}, "scale": self.scale,
                 "scale_stderr": self.scale_stderr, "correl": self.correl,
                 "excluded": self.excluded, "nfev": self.nfev, "elapsed_s": self.elapsed,
                 "model_spec": self.model.to_dict()}
-
-
-def _bound_note(theta: np.ndarray, lo: np.ndarray, hi: np.ndarray, names: Any) -> str:
-    """``"; at a bound: a, b"`` for the parameters within 1e-9 of the bounds' span of one."""
-    tol = 1e-9 * (hi - lo)
-    at = [nm for nm, t, a, b, e in zip(names, theta, lo, hi, tol, strict=True)
-          if abs(t - a) <= e or abs(t - b) <= e]
-    return f"; at a bound: {', '.join(at)}" if at else ""
 
 
 def clean_json(v: Any) -> Any:
@@ -225,6 +236,9 @@ class FitResult:
     #: so that predictions and plots average the model the same way (:meth:`predict`, :meth:`plot`)
     aperture: float | None = None
     aperture_points: int = 19
+    #: the input file as it was when the fit ran: ``{"file", "file_abspath", "file_sha256"}``
+    #: (:func:`input_source`; None: taken from the measurement when needed)
+    source: dict[str, str | None] | None = field(default=None, repr=False)
 
     # single-channel shortcuts -------------------------------------------------------------------
     def _one(self, what: str) -> ChannelFit:
@@ -299,23 +313,37 @@ class FitResult:
 
     # output ---------------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
-        """The ``fit.json`` content (keys ``model``, ``file``, ``loss``, ``channels`` ...)."""
+        """The ``fit.json`` content (keys ``model``, ``file``, ``file_abspath``,
+        ``file_sha256``, ``loss``, ``channels`` ...; ``docs/fitting.md``, "Output files").
+
+        ``file`` is the path as the measurement recorded it, ``file_abspath`` the absolute path
+        and ``file_sha256`` the SHA-256 of the file's bytes when the fit ran (both None when
+        the measurement did not come from a file that could be read), so that a later reader
+        finds the input from any folder and can tell whether it has changed since.
+        """
         meta = self.measurement.meta
         ap = self.instrument
+        src = self.source if self.source is not None else input_source(self.measurement)
         return clean_json({
-            "model": self.model_name, "file": meta.get("file"), "loss": self.loss,
+            "model": self.model_name, "file": meta.get("file"),
+            "file_abspath": src.get("file_abspath"), "file_sha256": src.get("file_sha256"),
+            "loss": self.loss,
             "quantity": self.measurement.quantity, "compared": self.compared,
             "relative_to": self.relative_to, "sample": meta.get("sample"),
             "options": self.options, "aperture": None if ap is None else ap.to_dict(),
             "elapsed_s": self.elapsed, "channels": [c.to_dict() for c in self.channels],
         })
 
-    def to_json(self, path: str | None = None, *, indent: int = 2) -> str:
-        """JSON text of :meth:`to_dict` (strict JSON: NaN written as ``null``); optionally saved."""
+    def to_json(self, path: str | os.PathLike | None = None, *, indent: int = 2,
+                overwrite: bool = False) -> str:
+        """JSON text of :meth:`to_dict` (strict JSON: NaN written as ``null``); optionally saved
+        to ``path`` (atomically, :func:`roughbrdf.output.atomic_write`; an existing file is
+        replaced only with ``overwrite=True``, else ``FileExistsError``)."""
         text = json.dumps(self.to_dict(), indent=indent, allow_nan=False)
         if path is not None:
-            with open(path, "w", encoding="utf-8") as fh:
-                fh.write(text + "\n")
+            from ..output import atomic_write
+
+            atomic_write(path, text + "\n", overwrite=overwrite)
         return text
 
     def report(self, *, min_correl: float = 0.1) -> str:
@@ -372,26 +400,87 @@ class FitResult:
             out.append(f"fit_{safe or 'channel'}.png")
         return out
 
-    def save(self, out_dir: str | Any, *, plots: bool = True, force: bool = False,
-             dpi: int = 110) -> list[Any]:
-        """Write ``fit.json``, ``report.txt`` and one ``fit_<channel>.png`` per channel.
+    def save(self, out_dir: str | os.PathLike, *, plots: bool = True, overwrite: bool = False,
+             dpi: int = 110) -> list[Path]:
+        """Write ``fit.json``, ``report.txt`` and one ``fit_<channel>.png`` per channel, as one set.
 
-        ``out_dir`` may exist. Files roughbrdf wrote there before are replaced; any other file of
-        the same name stops the call with ``FileExistsError`` before anything is written, unless
-        ``force=True`` (see :mod:`roughbrdf._outdir`). Returns the paths written.
+        Everything goes through :class:`roughbrdf.output.ResultFolder`: the folder may exist,
+        but a folder that holds results already (an earlier run's, listed in its manifest) or
+        any file of these names is refused with ``FileExistsError`` *before* anything is drawn
+        or written, unless ``overwrite=True`` (the CLI's ``--force``); even then a file of the
+        same name that roughbrdf did not write is never replaced. The files are staged and
+        committed together at the end: an error or Ctrl-C leaves the folder as it was (the
+        previous complete set), never a mix, never a 0-byte file.
+
+        Parameters
+        ----------
+        out_dir : str or path-like
+            The folder (created if needed).
+        plots : bool
+            Draw ``fit_<channel>.png`` (:meth:`plot`).
+        overwrite : bool
+            Replace the set of results in ``out_dir`` (stale files of the old set are removed).
+        dpi : int
+            Resolution of the PNGs.
+
+        Returns
+        -------
+        list of pathlib.Path
+            The paths written: ``fit.json``, ``report.txt``, then the PNGs.
         """
-        from .._outdir import OutputDir
+        from ..output import ResultFolder
 
-        out = OutputDir(out_dir, force=force)
         names = ["fit.json", "report.txt", *(self.plot_names() if plots else [])]
-        out.check(names)
-        written = [out.file("fit.json")]
-        self.to_json(str(written[0]))
-        written.append(out.write_text("report.txt", self.report()))
-        if plots:
-            for i, name in enumerate(self.plot_names()):
-                fig, _ = self.plot(i)
-                path = out.file(name)
-                fig.savefig(path, dpi=dpi, metadata={"Software": "roughbrdf"})
-                written.append(path)
-        return written
+        with ResultFolder(out_dir, overwrite=overwrite) as out:
+            out.check(names)  # refuse before the (slow) drawing
+            out.add("fit.json", self.to_json() + "\n")
+            text = self.report()
+            out.add("report.txt", text if text.endswith("\n") else text + "\n")
+            if plots:
+                for i, name in enumerate(self.plot_names()):
+                    fig, _ = self.plot(i)
+                    out.add(name, _png_writer(fig, dpi), binary=True)
+        return [out.path / n for n in names]
+
+
+def _png_writer(fig: Any, dpi: int) -> Callable[[IO[bytes]], None]:
+    """A function drawing ``fig`` as PNG into the open (staged) file it is given."""
+    def write(fh: IO[bytes]) -> None:
+        fig.savefig(fh, format="png", dpi=dpi, metadata={"Software": "roughbrdf"})
+    return write
+
+
+def input_source(meas: Measurement) -> dict[str, str | None]:
+    """``{"file", "file_abspath", "file_sha256"}`` of the file ``meas`` was read from.
+
+    ``file`` is ``meta["file"]`` as recorded; ``file_abspath`` and ``file_sha256`` come from
+    the reader's ``meta`` when it recorded them, else from the file itself (read now), and are
+    None when the measurement did not come from a file or the file cannot be read.
+
+    Examples
+    --------
+    >>> from roughbrdf.measurement import Measurement
+    >>> input_source(Measurement([0.1], [0.2], [0.0], [1.0]))
+    {'file': None, 'file_abspath': None, 'file_sha256': None}
+    """
+    meta = meas.meta
+    f = meta.get("file")
+    out: dict[str, str | None] = {"file": None if f is None else str(f),
+                                  "file_abspath": meta.get("file_abspath"),
+                                  "file_sha256": meta.get("file_sha256")}
+    if f is None or (out["file_abspath"] and out["file_sha256"]):
+        return out
+    path = Path(str(out["file_abspath"] or f))
+    if not path.is_file():
+        return out
+    out["file_abspath"] = out["file_abspath"] or str(path.resolve())
+    if not out["file_sha256"]:
+        h = hashlib.sha256()
+        try:
+            with open(path, "rb") as fh:
+                for block in iter(lambda: fh.read(1 << 20), b""):
+                    h.update(block)
+        except OSError:
+            return out
+        out["file_sha256"] = h.hexdigest()
+    return out

@@ -1,11 +1,13 @@
 """The global search of one channel: Sobol screening, local fits from several starts, polish.
 
-``docs/fitting.md`` ("Global search"): ``starts`` local fits (``scipy.optimize.least_squares``,
-trust-region reflective, box bounds) per channel: one from the model's own values, one from the
-previous channel's optimum when there is one (a warm start), and ``starts - 1`` from scrambled
-Sobol points (:func:`sobol_points`) in the bounds of the free parameters, chosen by
-:func:`screen` among ``screen`` candidates (one model evaluation each: the lowest cost, kept at
-least :data:`SCREEN_DIST` of the bounds apart). When a channel has more than ``subsample``
+``docs/fitting.md`` ("Global search"): exactly ``starts`` local fits
+(``scipy.optimize.least_squares``, trust-region reflective, box bounds) per channel: one from the
+model's own values, one from the previous channel's optimum when there is one and ``starts >=
+2`` (a warm start), and the rest from scrambled Sobol points (:func:`sobol_points`) in the bounds
+of the free parameters, chosen by :func:`screen` among ``screen`` candidates (one model
+evaluation each: the lowest cost, kept at least :data:`SCREEN_DIST` of the bounds apart).
+(Until 2026-11 the warm start came on top of ``starts``: a report of a second channel said
+``# starts = 9`` when 8 were asked.) When a channel has more than ``subsample``
 samples, the local fits explore a fixed random subsample (loose tolerance
 :data:`EXPLORE_TOL`: they only need to find the basin) and the ``polish`` best distinct end
 points are refined on all samples (:data:`POLISH_TOL`); the best is the result.
@@ -24,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..errors import ArgumentError
 from .objective import Objective, ObjectiveSpec
 
 if TYPE_CHECKING:
@@ -55,11 +58,13 @@ class SearchOptions:
     seed: int | None = 0
 
     def __post_init__(self) -> None:
-        starts = int(self.starts)
-        if starts < 1:
-            raise ValueError(f"starts must be >= 1, got {starts}")
-        object.__setattr__(self, "starts", starts)
-        object.__setattr__(self, "polish", max(1, int(self.polish)))
+        object.__setattr__(self, "starts", _count("starts", self.starts, 1))
+        object.__setattr__(self, "screen", _count("screen", self.screen, 0))
+        object.__setattr__(self, "subsample", _count("subsample", self.subsample, 1, True))
+        object.__setattr__(self, "polish", max(1, _count("polish", self.polish, 0)))
+        object.__setattr__(self, "max_nfev", _count("max_nfev", self.max_nfev, 1, True))
+        if self.seed is not None and not isinstance(self.seed, int | np.integer):
+            raise ArgumentError("seed", f"seed must be None or an integer, got {self.seed!r}")
 
     @property
     def n_screen(self) -> int:
@@ -78,8 +83,10 @@ class SearchOutcome:
     result : scipy.optimize.OptimizeResult or None
         Its local fit.
     tried : list of dict
-        Every local fit: ``{"x0", "x", "cost", "stage"}`` with ``stage`` ``"single"`` (on all
-        samples, no polish), ``"explore"`` (on the subsample) or ``"full"`` (polish).
+        Every local fit: ``{"x0", "x", "cost", "stage", "origin"}`` with ``stage``
+        ``"single"`` (on all samples, no polish), ``"explore"`` (on the subsample) or ``"full"``
+        (polish), and ``origin`` where its start came from: ``"model"`` (the model's values),
+        ``"previous channel"`` (its optimum), ``"sobol"`` or, for a polish, ``"explored"``.
     explore_nfev : int
         Model evaluations of the exploration on the subsample (0 without one).
     """
@@ -88,6 +95,18 @@ class SearchOutcome:
     result: Any
     tried: list[dict[str, Any]] = field(default_factory=list)
     explore_nfev: int = 0
+
+
+def _count(name: str, value: Any, minimum: int, none_ok: bool = False) -> Any:
+    """``value`` as an int ``>= minimum`` (or None where allowed), else an ArgumentError."""
+    if value is None and none_ok:
+        return None
+    ok = isinstance(value, int | np.integer) and not isinstance(value, bool) or (
+        isinstance(value, float) and value.is_integer())
+    if not ok or int(value) < minimum:
+        raise ArgumentError(name, f"{name} must be >= {minimum} (an integer"
+                            f"{', or None' if none_ok else ''}), got {value!r}")
+    return int(value)
 
 
 def sobol_points(lower: np.ndarray, upper: np.ndarray, n: int, seed: Any) -> np.ndarray:
@@ -158,19 +177,21 @@ def _distinct(points: list[np.ndarray], k: int, span: np.ndarray) -> list[np.nda
 
 
 def search(full: Objective, explore: Objective, starts: list[np.ndarray],
-           options: SearchOptions, on_start: Callable[[], Any] | None = None) -> SearchOutcome:
+           options: SearchOptions, on_start: Callable[[], Any] | None = None,
+           origins: list[str] | None = None) -> SearchOutcome:
     """Local fits of ``explore`` from each start; when ``explore`` is a subsample, the
     ``polish`` best distinct end points refined on ``full``. ``on_start`` is called after each
-    exploring fit (progress)."""
+    exploring fit (progress); ``origins`` names where each start came from (for ``tried``)."""
     lo, hi = full.spec.lower, full.spec.upper
     single = explore is full
     tried: list[dict[str, Any]] = []
     ends: list[tuple[float, np.ndarray, Any]] = []
-    for p0 in starts:
+    origins = origins if origins is not None else ["given"] * len(starts)
+    for p0, origin in zip(starts, origins, strict=True):
         p0 = np.clip(p0, lo, hi)
         res = local_fit(explore, p0, EXPLORE_TOL, options.max_nfev)
         tried.append({"x0": p0.tolist(), "x": res.x.tolist(), "cost": float(res.cost),
-                      "stage": "single" if single else "explore"})
+                      "stage": "single" if single else "explore", "origin": origin})
         ends.append((float(res.cost), res.x, res))
         if on_start is not None:
             on_start()
@@ -182,7 +203,7 @@ def search(full: Objective, explore: Objective, starts: list[np.ndarray],
     for xe in chosen:
         res = local_fit(full, xe, POLISH_TOL, options.max_nfev)
         tried.append({"x0": xe.tolist(), "x": res.x.tolist(), "cost": float(res.cost),
-                      "stage": "full"})
+                      "stage": "full", "origin": "explored"})
         if res.cost < best_cost:
             best_cost, best_x, best = float(res.cost), res.x, res
     return SearchOutcome(best_x, best, tried, explore.nfev)
@@ -227,11 +248,20 @@ class MultiStart:
         return full, Objective(self.spec, data.take(sub))
 
     def run(self, data: ChannelData) -> tuple[Objective, SearchOutcome]:
-        """Search one channel; returns the objective on all its samples and the outcome."""
+        """Search one channel; returns the objective on all its samples and the outcome.
+
+        Exactly ``options.starts`` local fits explore: the model's values, the previous
+        channel's optimum (when there is one and ``starts >= 2``), then Sobol points."""
         full, explore = self.objectives(data)
-        starts = [self.start] + ([self.warm] if self.warm is not None else []) + screen(
-            explore, self.candidates, self.options.starts - 1)
-        outcome = search(full, explore, starts, self.options, self.on_start)
+        n = self.options.starts
+        starts, origins = [self.start], ["model"]
+        if self.warm is not None and n >= 2:
+            starts.append(self.warm)
+            origins.append("previous channel")
+        sobol = screen(explore, self.candidates, n - len(starts))
+        starts += sobol
+        origins += ["sobol"] * len(sobol)
+        outcome = search(full, explore, starts, self.options, self.on_start, origins)
         self.warm = outcome.theta.copy()
         return full, outcome
 

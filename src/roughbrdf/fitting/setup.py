@@ -2,8 +2,9 @@
 
 The model (an instance or a registered name), the measurement, the channels, the free parameters
 and their bounds (:class:`FreeParameters`), and the data scale ``K`` (free for relative data,
-fixed otherwise: :func:`data_scale`). Every bad option raises ``ValueError`` here, before any
-fit runs.
+fixed otherwise: :func:`data_scale`). Every bad option raises
+:class:`~roughbrdf.errors.ArgumentError` (a ``ValueError`` naming the argument, worded for
+Python by ``str`` and for the CLI by ``render``) here, before any fit runs.
 """
 
 from __future__ import annotations
@@ -15,14 +16,15 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import ArgumentError
 from ..measurement import Measurement
-from ..models import Model
+from ..models import Model, Parameter
 from ..quantity import Quantity
 from .data import ChannelData, where
 from .objective import ObjectiveSpec
 
-__all__ = ["FreeParameters", "as_model", "channel_indices", "check_enough_data", "data_scale",
-           "model_label"]
+__all__ = ["BoundsFix", "FreeParameters", "as_model", "channel_indices", "check_enough_data",
+           "data_scale", "model_label"]
 
 
 def as_model(model: Model | str) -> Model:
@@ -73,11 +75,21 @@ class FreeParameters:
         """Every parameter of ``model`` that is not in ``fix`` nor switched off (value None),
         with ``bounds`` overriding the model's own."""
         names = model.param_names
-        fixed = [fix] if isinstance(fix, str) else list(fix)
+        try:
+            fixed = [fix] if isinstance(fix, str) else [str(f) for f in fix]
+        except TypeError:
+            raise ArgumentError("fix", f"fix must be a parameter name or a list of them, got "
+                                f"{fix!r}") from None
+        if bounds is not None and not isinstance(bounds, Mapping):
+            raise ArgumentError("bounds", f"bounds must be a mapping name -> (low, high), got "
+                                f"{bounds!r}")
         bounds = dict(bounds or {})
-        for nm in [*fixed, *bounds]:
+        for arg, nm in [*(("fix", f) for f in fixed), *(("bounds", b) for b in bounds)]:
             if nm not in names:
-                model.with_values([nm], [0.0])  # raises the registry's "unknown parameter" error
+                try:  # the registry's "unknown parameter" error, with its suggestions
+                    model.with_values([nm], [0.0])
+                except ValueError as exc:
+                    raise ArgumentError(arg, f"{arg}: {exc}") from None
         specs = {p.name: p for p in model.parameters}
         free = [n for n in names if n not in fixed and specs[n].value is not None]
         if not free:
@@ -87,15 +99,13 @@ class FreeParameters:
                              f"to fit; free at least one of {names}")
         lo, hi, x0 = (np.empty(len(free)) for _ in range(3))
         for j, nm in enumerate(free):
-            b = bounds.get(nm, specs[nm].bounds)
-            lo[j], hi[j] = float(b[0]), float(b[1])
-            if not lo[j] < hi[j]:
-                raise ValueError(f"bounds of {nm!r} must satisfy low < high, got {tuple(b)}")
+            lo[j], hi[j] = _bounds_of(specs[nm], bounds.get(nm, specs[nm].bounds))
             x0[j] = float(specs[nm].value)  # type: ignore[arg-type]  # not None: free
             if not lo[j] <= x0[j] <= hi[j]:
-                raise ValueError(f"starting value {nm} = {x0[j]:g} is outside its bounds "
-                                 f"[{lo[j]:g}, {hi[j]:g}]; pass bounds={{{nm!r}: (low, high)}} or "
-                                 f"another starting value")
+                raise ArgumentError(
+                    "bounds", f"starting value {nm} = {x0[j]:g} is outside its bounds "
+                    f"[{lo[j]:g}, {hi[j]:g}] (give another starting value, or bounds that "
+                    f"contain it)", fix=BoundsFix(nm))
         return cls(tuple(free), lo, hi, x0)
 
     def spec(self, model: Model, *, loss: str, quantity: Quantity | str, free_scale: bool,
@@ -105,16 +115,66 @@ class FreeParameters:
                              quantity=quantity, free_scale=free_scale, fixed_scale=fixed_scale)
 
 
+class BoundsFix:
+    """The ``fix`` of an :class:`~roughbrdf.errors.ArgumentError` about ``bounds``: shown as
+    ``bounds={'e': (low, high)}`` in Python (``repr``) and ``--bounds e=LOW:HIGH`` on the
+    command line (``str``).
+
+    Examples
+    --------
+    >>> from roughbrdf.errors import ArgumentError
+    >>> err = ArgumentError("bounds", "e = 5 is outside [0.02, 3]", fix=BoundsFix("e"))
+    >>> str(err)
+    "e = 5 is outside [0.02, 3]; pass bounds={'e': (low, high)}"
+    >>> err.render({"bounds": "--bounds"})
+    'e = 5 is outside [0.02, 3]; pass --bounds e=LOW:HIGH'
+    """
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+
+    def __repr__(self) -> str:
+        return f"{{{self.name!r}: (low, high)}}"
+
+    def __str__(self) -> str:
+        return f"{self.name}=LOW:HIGH"
+
+
+def _bounds_of(spec: Parameter, b: Any) -> tuple[float, float]:
+    """``(low, high)`` of one free parameter: two numbers, ``low < high``, inside the
+    parameter's physical domain (a fit must not try values the model refuses)."""
+    nm = spec.name
+    try:
+        lo, hi = (float(v) for v in b)
+    except (TypeError, ValueError, OverflowError):
+        raise ArgumentError("bounds", f"bounds of {nm!r} must be two numbers (low, high), got "
+                            f"{b!r}") from None
+    if not lo < hi:
+        raise ArgumentError("bounds", f"bounds of {nm!r} must satisfy low < high, got "
+                            f"{tuple(b)}")
+    dlo, lo_inc, dhi, hi_inc = spec.domain
+    inside = ((lo >= dlo if lo_inc else lo > dlo) and (hi <= dhi if hi_inc else hi < dhi))
+    if not inside:
+        raise ArgumentError("bounds", f"bounds of {nm!r} [{lo:g}, {hi:g}] leave its physical "
+                            f"domain {spec.domain_text()}" + (
+                                f" ({spec.description})" if spec.description else ""))
+    return lo, hi
+
+
 def data_scale(meas: Measurement, free_scale: bool | None, scale: float | None
                ) -> tuple[bool, float]:
     """``(free_scale, fixed_scale)``: a known ``scale`` is fixed; otherwise ``K`` is free for
     relative data unless ``free_scale`` says otherwise."""
     if scale is not None:
-        fixed = float(scale)
+        try:
+            fixed = float(scale)
+        except (TypeError, ValueError, OverflowError):
+            fixed = math.nan
         if not (math.isfinite(fixed) and fixed > 0):
-            raise ValueError(f"scale must be finite and > 0, got {scale!r}")
+            raise ArgumentError("scale", f"scale must be finite and > 0, got {scale!r}")
         if free_scale:
-            raise ValueError("give either scale= (a known data scale) or free_scale=True")
+            raise ArgumentError("scale", "give either scale= (a known data scale) or "
+                                "free_scale=True")
         return False, fixed
     if free_scale is None:
         free_scale = meas.quantity == "relative"

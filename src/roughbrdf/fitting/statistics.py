@@ -8,12 +8,18 @@ and statistics").
   Jacobian of the residuals at the optimum (free parameters, plus the analytic column of the
   scale ``K`` when it is free): scaled by the residual variance as lmfit does by default
   (``scale_covar=True``); ``stderr = sqrt(diag(covar))``, ``correl`` is ``covar`` normalized. A
-  singular ``J^T J`` gives NaN and a note for the message.
+  singular ``J^T J`` gives NaN and a note for the message;
+* :func:`at_bound` -- the parameters at (or within :data:`AT_BOUND_RTOL` of the width of their
+  bounds from) a bound. They get no standard error: the covariance describes the cost as a
+  quadratic bowl around an interior optimum, which an active bound is not (the optimum there is
+  set by the bound, not by the data, and the bowl may not even curve up along that
+  parameter). The covariance of the others is computed with them held at their bounds.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -22,7 +28,36 @@ import numpy as np
 if TYPE_CHECKING:
     from .objective import Objective
 
-__all__ = ["Covariance", "GoodnessOfFit", "rms_log", "tr75_sigma"]
+__all__ = ["AT_BOUND_RTOL", "Covariance", "GoodnessOfFit", "at_bound", "rms_log", "tr75_sigma"]
+
+#: a parameter within this fraction of the width of its bounds from a bound is "at the bound"
+AT_BOUND_RTOL = 1e-6
+
+
+def at_bound(theta: np.ndarray, lower: np.ndarray, upper: np.ndarray, names: Sequence[str],
+             rtol: float = AT_BOUND_RTOL) -> dict[str, str]:
+    """``{name: "lower" | "upper"}`` for the parameters at a bound.
+
+    A parameter is at a bound when it is within ``rtol`` times the width of its bounds of it
+    (``rtol`` times ``max(1, |bound|)`` when the other bound is infinite).
+
+    Examples
+    --------
+    >>> at_bound(np.array([5e-13, 0.5, 4.99999999]), np.zeros(3), np.array([10.0, 1.0, 5.0]),
+    ...          ["k", "e", "n"])
+    {'k': 'lower', 'n': 'upper'}
+    """
+    out: dict[str, str] = {}
+    for nm, t, lo, hi in zip(names, theta, lower, upper, strict=True):
+        span = hi - lo
+        for side, b, dist in (("lower", lo, t - lo), ("upper", hi, hi - t)):
+            if not math.isfinite(b):
+                continue
+            tol = rtol * (span if math.isfinite(span) else max(1.0, abs(b)))
+            if dist <= tol:
+                out[nm] = side
+                break
+    return out
 
 
 def tr75_sigma(data: np.ndarray, model: np.ndarray, scale: float = 1.0,
@@ -123,6 +158,8 @@ class Covariance:
                       dof: int) -> Covariance:
         """``(J^T J)^-1 chi2/dof`` through the SVD of ``J``; NaN (and a note) if singular."""
         p = jmat.shape[1]
+        if p == 0:
+            return cls(np.empty((0, 0)), names)
         try:
             _, s, vt = np.linalg.svd(jmat, full_matrices=False)
             if not np.all(np.isfinite(s)) or s[0] == 0 or s[-1] <= s[0] * 1e-12:
@@ -135,15 +172,25 @@ class Covariance:
 
     @classmethod
     def at_optimum(cls, obj: Objective, theta: np.ndarray, f: np.ndarray, k: float, *,
-                   chi2: float, dof: int) -> Covariance:
+                   chi2: float, dof: int, held: Sequence[str] = ()) -> Covariance:
         """From the central-difference Jacobian of ``obj`` at ``theta`` (scale held at ``k``)
-        and, when the scale is free, its analytic column at the model values ``f``."""
-        cols = [obj.jac_central(theta, k)]
+        and, when the scale is free, its analytic column at the model values ``f``.
+
+        Parameters named in ``held`` (those :func:`at_bound`) are held where they are: they
+        get no column, and NaN rows and columns in the result (no standard error, no
+        correlation)."""
         names = list(obj.spec.free)
+        keep = [j for j, nm in enumerate(names) if nm not in held]
+        cols = [obj.jac_central(theta, k, columns=keep)]
         if obj.spec.free_scale:
             cols.append(obj.scale_column(f, k)[:, None])
             names.append("scale")
-        return cls.from_jacobian(np.hstack(cols), names, chi2=chi2, dof=dof)
+            keep.append(len(names) - 1)
+        inner = cls.from_jacobian(np.hstack(cols), [names[j] for j in keep], chi2=chi2,
+                                  dof=dof)
+        full = np.full((len(names), len(names)), np.nan)
+        full[np.ix_(keep, keep)] = inner.matrix
+        return cls(full, names, inner.note)
 
     def stderr(self) -> np.ndarray:
         """``sqrt(diag(covar))`` (NaN where not estimable)."""

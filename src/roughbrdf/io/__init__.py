@@ -19,7 +19,18 @@ rows - and every reader applies the same two rules, from :mod:`roughbrdf.io._com
 unit (``angles=`` option, else the file's declarations, else the format's default or an error
 where a declaration is required) and the quantity (``quantity=`` option, else the file's
 declaration, else the format's default or an error), as a
-:class:`~roughbrdf.quantity.Quantity`.
+:class:`~roughbrdf.quantity.Quantity`. An option that contradicts the file, a header key given
+twice and two declarations that disagree are :class:`FormatError` naming both places; a file
+that ends inside a number without a final line end is read with an
+:class:`UnterminatedRowWarning`.
+
+``write(m, path)`` never replaces an existing file unless ``overwrite=True`` (the CLI's
+``--force``), never writes onto the file ``m`` was read from, and writes atomically (a temporary
+file renamed over ``path``: an error or Ctrl-C leaves the old file or none). Written in its own
+format, a measurement keeps every header key it was read with; what another format has no
+place for is named in a :class:`LossyWriteWarning`. MERL's fixed grid changes most
+measurements' samples, so writing MERL needs ``resample=True`` for them and returns a report of
+what was binned, averaged and dropped (:class:`~roughbrdf.io.merl.MerlWriteReport`).
 """
 
 from __future__ import annotations
@@ -31,9 +42,10 @@ from pathlib import Path
 from typing import Any
 
 from ..measurement import Measurement
-from ._common import FormatError
+from ._common import FormatError, FormatWarning, LossyWriteWarning, UnterminatedRowWarning
 
-__all__ = ["read", "write", "FormatError", "FORMATS", "format_for"]
+__all__ = ["read", "write", "FormatError", "FormatWarning", "LossyWriteWarning",
+           "UnterminatedRowWarning", "FORMATS", "format_for"]
 
 #: format name -> module name under roughbrdf.io
 FORMATS = {"astm": "astm", "alta": "alta", "merl": "merl", "csv": "csv"}
@@ -118,7 +130,16 @@ def read(path: str | os.PathLike, format: str | None = None, **options: Any) -> 
         Override the format chosen from the extension.
     **options
         Passed to the format's reader, e.g. ``quantity="brdf_cos"`` (ALTA without
-        ``#PARAM_OUT``), ``angles="deg"`` (ASTM), ``stride=4`` (MERL).
+        ``#PARAM_OUT``), ``angles="deg"`` (ASTM), ``stride=4`` (MERL). ``quantity=`` and
+        ``angles=`` supply what the file does not say; if the file says otherwise they raise
+        :class:`FormatError` (every reader accepts both).
+
+    Raises
+    ------
+    FormatError
+        Anything wrong with the file, naming it and, where one line is at fault, the line.
+    FileNotFoundError
+        No file at ``path``.
     """
     p = Path(path)
     if not p.exists():
@@ -127,11 +148,42 @@ def read(path: str | os.PathLike, format: str | None = None, **options: Any) -> 
     return _module(fmt).read(p, **options)
 
 
-def write(measurement: Measurement, path: str | os.PathLike, format: str | None = None,
-          **options: Any) -> None:
-    """Write a measurement in the format chosen from the extension (``format=`` overrides)."""
+def write(measurement: Measurement, path: str | os.PathLike, format: str | None = None, *,
+          overwrite: bool = False, **options: Any) -> Any:
+    """Write a measurement in the format chosen from the extension (``format=`` overrides).
+
+    Parameters
+    ----------
+    measurement : Measurement
+    path : str or path-like
+        The file to write; never the file ``measurement`` was read from.
+    format : {"astm", "alta", "merl", "csv"}, optional
+        Override the format chosen from the extension.
+    overwrite : bool
+        Replace an existing file (default: refuse with :class:`FileExistsError`).
+    **options
+        Passed to the format's writer, e.g. ``angles="rad"`` (CSV, ASTM), ``resample=True``
+        (MERL: write even though the grid bins, averages or drops samples).
+
+    Returns
+    -------
+    MerlWriteReport or None
+        For MERL, what the grid did to the samples; None for the other formats.
+
+    Raises
+    ------
+    FileExistsError
+        ``path`` exists and ``overwrite`` is false.
+    roughbrdf.errors.ArgumentError
+        ``path`` is the measurement's own input file (even with ``overwrite=True``), or MERL
+        would change the samples and ``resample`` is false.
+    IsADirectoryError
+        ``path`` is a folder.
+    ValueError
+        A measurement the format cannot hold (e.g. relative values in ASTM).
+    """
     fmt = format_for(path, format)
     mod = _module(fmt)
     if not hasattr(mod, "write"):
         raise FormatError(f"format {fmt!r} has no writer", path)
-    mod.write(measurement, path, **options)
+    return mod.write(measurement, path, overwrite=overwrite, **options)

@@ -15,26 +15,42 @@ A text reader's ``read()`` is a short sequence of phases, each reading one part 
    :func:`azimuth_rows` check the angle columns;
 
 and ends in a :class:`~roughbrdf.measurement.Measurement`. Every problem is a
-:class:`FormatError` naming the file and, where one line is at fault, the line.
+:class:`FormatError` naming the file and, where one line is at fault, the line; a header key
+given twice is one (:func:`add_key`, naming both lines), and so is an option (``angles=``,
+``quantity=``) that contradicts the file. A file that ends inside a number without a final line
+end is read, with an :class:`UnterminatedRowWarning` naming the line.
+
+The writers share :func:`prepare_target` (never an existing file unless ``overwrite=True``,
+never the measurement's own input), :func:`write_table` (atomic, through
+:func:`roughbrdf.output.staged`) and :func:`warn_not_written` (a :class:`LossyWriteWarning`
+naming what the target format has no place for).
 """
 
 from __future__ import annotations
 
+import importlib
 import math
 import os
-from collections.abc import Sequence
+import sys
+import warnings
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
+from ..errors import ArgumentError
 from ..geometry import angles_from_vectors
+from ..output import same_file, staged
 from ..quantity import Quantity
 
-__all__ = ["FormatError", "read_text", "begin_read", "data_lines", "parse_rows",
+__all__ = ["FormatError", "FormatWarning", "LossyWriteWarning", "UnterminatedRowWarning",
+           "read_text", "begin_read", "add_key", "data_lines", "parse_rows",
            "check_zenith_rows", "azimuth_rows", "common_frame_from_spherical", "angle_factor",
-           "AngleUnit", "UnitClaim", "resolve_angle_unit", "QuantityClaim", "resolve_quantity"]
+           "AngleUnit", "UnitClaim", "resolve_angle_unit", "QuantityClaim", "resolve_quantity",
+           "check_fixed_units", "prepare_target", "write_table", "warn_not_written",
+           "header_not_written", "describe_keys", "write_bytes", "LAYOUT"]
 
 HALF_PI = 0.5 * math.pi
 #: angles this far beyond pi/2 (radians) are rounding in the file and are clipped to pi/2
@@ -59,15 +75,58 @@ class FormatError(ValueError):
         super().__init__(f"{where}: {message}")
 
 
+class FormatWarning(UserWarning):
+    """Base of the warnings of :mod:`roughbrdf.io` (a file read or written with a caveat)."""
+
+
+class UnterminatedRowWarning(FormatWarning):
+    """The file ends inside a number, without a final line end: the last row is read, but its
+    last number may have been cut short (an interrupted copy or download). The message names
+    the file and the line."""
+
+
+class LossyWriteWarning(FormatWarning):
+    """A writer had no place in the target format for part of the measurement (header keys of
+    the source file, uncertainties...); the message names each of them."""
+
+
+def _outside_stacklevel() -> int:
+    """``stacklevel`` for :func:`warnings.warn`, called from the function that warns, pointing
+    at the first caller outside roughbrdf (the user's line, not the reader's)."""
+    frame = sys._getframe(2)
+    level = 2
+    while frame is not None and str(frame.f_globals.get("__name__", "")).startswith(
+            "roughbrdf"):
+        frame = frame.f_back  # type: ignore[assignment]
+        level += 1
+    return level
+
+
+#: characters a number can end with: a file ending on one of them may end inside a number
+_NUMBER_END = frozenset("0123456789.")
+
+
 def read_text(path: str | os.PathLike) -> list[str]:
-    """The file's lines (no line ends). Undecodable bytes become U+FFFD instead of failing."""
+    """The file's lines (no line ends). Undecodable bytes become U+FFFD instead of failing.
+
+    Warns (:class:`UnterminatedRowWarning`) when the file ends inside a number without a final
+    line end.
+    """
     p = Path(path)
     if not p.exists():
         raise FileNotFoundError(f"{p}: no such file")
     if p.is_dir():
         raise FormatError("is a directory, not a measurement file", p)
     with open(p, encoding="utf-8-sig", errors="replace", newline=None) as fh:
-        return fh.read().splitlines()
+        text = fh.read()
+    lines = text.splitlines()
+    if lines and text[-1] in _NUMBER_END and not lines[-1].lstrip().startswith("#"):
+        tail = lines[-1].strip()[-24:]
+        warnings.warn(f"{p}, line {len(lines)}: the file ends inside a number without a line "
+                      f"end (...{tail!r}); the row is read, but its last number may be cut "
+                      "short - check that the file is complete", UnterminatedRowWarning,
+                      stacklevel=_outside_stacklevel())
+    return lines
 
 
 def begin_read(fmt: str, path: str | os.PathLike, options: dict, quantity: object = None
@@ -82,6 +141,23 @@ def begin_read(fmt: str, path: str | os.PathLike, options: dict, quantity: objec
     if quantity is not None:
         Quantity.parse(quantity, "quantity")
     return Path(path), read_text(path)
+
+
+def add_key(keys: dict[str, str], lines: dict[str, int], key: str, value: str, line: int,
+            path, *, shown: str = "{key}") -> None:
+    """Record header ``key`` (its ``value`` and 1-based ``line``); a key given twice is a
+    :class:`FormatError` naming both lines - a file must not say one thing twice, since the
+    reader cannot know which one is meant.
+
+    ``shown`` formats the key for the message (``"#{key}"`` for ALTA).
+    """
+    if key in keys:
+        name = shown.format(key=key)
+        same = "the same value" if keys[key] == value else "different values"
+        raise FormatError(f"{name} is given twice, with {same}: line {lines[key]} "
+                          f"({keys[key]!r}) and line {line} ({value!r}); keep one", path, line)
+    keys[key] = value
+    lines[key] = line
 
 
 def data_lines(lines: list[str], start: int, *, comments: str | tuple[str, ...] = ()
@@ -178,7 +254,8 @@ def check_zenith_rows(values: np.ndarray, name: str, linenos, path, *, unit: str
         shown = math.degrees(v[k])
         hint = ""
         if unit == "rad" and v[k] > 2 * math.pi:
-            hint = " - the angles look like degrees; declare the unit (angles='deg')"
+            hint = (" - the angles look like degrees; declare the unit (angles='deg'; CLI: "
+                    "--angles-in deg)")
         raise FormatError(f"{name} = {float(v[k])!r} rad ({shown:.6g} deg) is outside [0, 90] deg"
                           f"{hint}", path, int(linenos[k]))
     return np.clip(v, 0.0, HALF_PI)
@@ -284,54 +361,78 @@ class UnitClaim:
         return units.pop()
 
 
+def _where(line: int | None) -> str:
+    return "" if line is None else f" (line {line})"
+
+
 def resolve_angle_unit(option: str | None, claims: Sequence[UnitClaim], path, *,
                        default: str | None = None, default_source: str = "default",
-                       agree: bool = False, missing: str = "missing angle units",
+                       missing: str = "missing angle units",
                        missing_line: int | None = None) -> AngleUnit:
     """The angle unit of a file: the one rule of every reader.
 
-    Precedence: the ``angles=`` option (never checked against the file), then the first of the
-    file's ``claims`` (in the format's order of precedence), then ``default``.
+    Every declaration in the file (``claims``) must name the same unit, and an ``angles=``
+    option must name that unit too: a contradiction is a :class:`FormatError` naming both
+    places. Where the file declares nothing, the option is used, else ``default``.
 
     Parameters
     ----------
     option : str or None
         The reader's ``angles=`` option (``deg``/``rad``; the CLI's ``--angles-in``).
     claims : sequence of UnitClaim
-        The file's declarations, highest precedence first.
+        The file's declarations, in the format's order of precedence (the first gives
+        ``AngleUnit.source``).
     path
         The file, for error messages.
     default : {"rad", "deg"} or None
-        The unit of a file that declares none; None means a declaration is **required** and
-        its absence is a :class:`FormatError` with message ``missing`` at ``missing_line``.
+        The unit of a file that declares none; None means a declaration (or the option) is
+        **required** and its absence is a :class:`FormatError` with message ``missing`` at
+        ``missing_line``.
     default_source : str
         ``AngleUnit.source`` when ``default`` is used.
-    agree : bool
-        If true, every claim must name the unit of the first (``"{first.text} contradicts
-        {other.text}"`` at the other's line); if false the first claim wins and the others are
-        not looked at.
 
     Examples
     --------
     ASTM E1392: radians unless declared; CSV: a declaration is required::
 
         resolve_angle_unit(angles, [header, vars_names], path, default="rad")
-        resolve_angle_unit(angles, [header, column_suffixes], path, agree=True,
+        resolve_angle_unit(angles, [header, column_suffixes], path,
                            missing="missing angle units: ...", missing_line=column_line)
     """
-    if option is not None:
-        return AngleUnit(unit_word(option, path), "option angles=")
+    wanted = None if option is None else unit_word(option, path)
     if not claims:
+        if wanted is not None:
+            return AngleUnit(wanted, "option angles=")
         if default is None:
             raise FormatError(missing, path, missing_line)
         return AngleUnit(unit_word(default, path), default_source)
     first, *others = claims
     unit = first.unit(path)
-    if agree:
-        for other in others:
-            if {unit_word(w, path, other.line) for w in other.words} != {unit}:
-                raise FormatError(f"{first.text} contradicts {other.text}", path, other.line)
+    for other in others:
+        if {unit_word(w, path, other.line) for w in other.words} != {unit}:
+            raise FormatError(f"{first.text}{_where(first.line)} contradicts {other.text}"
+                              f"{_where(other.line)}", path, other.line)
+    if wanted is not None and wanted != unit:
+        raise FormatError(f"angles={wanted!r} (CLI: --angles-in {wanted}) contradicts "
+                          f"{first.text}{_where(first.line)}, which says {unit}", path,
+                          first.line)
     return AngleUnit(unit, first.source)
+
+
+def check_fixed_units(fmt: str, angles: str | None, quantity: object, path,
+                      quantities: Sequence[Quantity] = (Quantity.BRDF,)) -> None:
+    """For a format whose angle unit and quantity are fixed by its definition (ALTA angles are
+    radians; MERL holds BRDF): an ``angles=`` or ``quantity=`` option that says otherwise
+    contradicts the file (:class:`FormatError`)."""
+    if angles is not None and unit_word(angles, path) != "rad":
+        raise FormatError(f"angles={angles!r} (CLI: --angles-in {angles}) contradicts the {fmt} "
+                          "format, whose angles are radians by definition", path)
+    if quantity is not None and quantities:
+        q = Quantity.parse(quantity, "quantity")
+        if not any(_agrees(q, k) for k in quantities):
+            raise FormatError(f"quantity={q.value!r} (CLI: --quantity {q.value}) contradicts "
+                              f"the {fmt} format, which holds "
+                              f"{' or '.join(k.value for k in quantities)}", path)
 
 
 # --------------------------------------------------------------------------------------------
@@ -361,40 +462,133 @@ class QuantityClaim:
     problem: str = ""
 
 
+def _agrees(a: Quantity, b: Quantity) -> bool:
+    """Whether two quantities name the same values (brdf_cos and bridf are the same numbers)."""
+    return a == b or (a.cosine_weighted and b.cosine_weighted)
+
+
 def resolve_quantity(option: object, claims: Sequence[QuantityClaim], path, *,
                      default: Quantity | None = None, default_source: str = "default",
-                     agree: bool = False, missing: str = "missing quantity",
+                     fallback: QuantityClaim | None = None, missing: str = "missing quantity",
                      missing_line: int | None = None) -> tuple[Quantity, str]:
     """What a file's values hold, and where that was said: the one rule of every reader.
 
-    Precedence: the ``quantity=`` option, then the first of the file's ``claims``, then
-    ``default`` (None: a declaration is required; :class:`FormatError` ``missing`` at
-    ``missing_line``). With ``agree``, an option must agree with every known claim, the
-    cosine-weighted quantities (``brdf_cos``, ``bridf``) agreeing with each other; the source is
-    then the claim's. Without ``agree`` the option wins unchecked (source ``"option quantity="``).
+    The file's declarations (``claims``) must agree with each other, and a ``quantity=``
+    option with every known one (``brdf_cos`` and ``bridf`` agree): a contradiction is a
+    :class:`FormatError` naming both places. A claim whose quantity is unknown (``MEAS_NAME
+    BTDF``) is an error unless the option says what the values hold. Where the file declares
+    nothing, the option is used, then ``fallback`` (a hint such as a CSV value column named
+    ``brdf``, never checked), then ``default`` (None: :class:`FormatError` ``missing`` at
+    ``missing_line``).
 
     Returns
     -------
     (Quantity, str)
-        The quantity and its source.
+        The quantity and its source (the first declaration's text, or ``"option quantity="``).
     """
+    known = [c for c in claims if c.quantity is not None]
+    for other in known[1:]:
+        first = known[0]
+        if not _agrees(first.quantity, other.quantity):  # type: ignore[arg-type]
+            raise FormatError(f"{first.source}{_where(first.line)} contradicts "
+                              f"{other.source}{_where(other.line)}", path, other.line)
     if option is not None:
         q = Quantity.parse(option, "quantity")
-        source = "option quantity="
-        for claim in claims if agree else ():
-            if claim.quantity is None:
-                continue
-            if q != claim.quantity and not (q.cosine_weighted and claim.quantity.cosine_weighted):
-                raise FormatError(f"quantity={q.value!r} contradicts {claim.source} "
-                                  f"({claim.quantity.value})", path, claim.line)
-            source = claim.source
-        return q, source
+        for claim in known:
+            if not _agrees(q, claim.quantity):  # type: ignore[arg-type]
+                raise FormatError(f"quantity={q.value!r} (CLI: --quantity {q.value}) "
+                                  f"contradicts {claim.source}{_where(claim.line)}, which "
+                                  f"says {claim.quantity.value}", path,  # type: ignore[union-attr]
+                                  claim.line)
+        return q, known[0].source if known else "option quantity="
     if claims:
-        claim = claims[0]
+        claim = known[0] if known else claims[0]
         if claim.quantity is None:
             raise FormatError(claim.problem or f"{claim.source} is not a BRDF quantity", path,
                               claim.line)
         return claim.quantity, claim.source
+    if fallback is not None and fallback.quantity is not None:
+        return fallback.quantity, fallback.source
     if default is None:
         raise FormatError(missing, path, missing_line)
     return Quantity.parse(default), default_source
+
+
+# --------------------------------------------------------------------------------------------
+# writing
+# --------------------------------------------------------------------------------------------
+#: what :func:`header_not_written` calls a header key that describes the data's layout
+#: (column names, counts, unit and quantity declarations): every writer writes its own
+LAYOUT = "<layout>"
+
+
+def prepare_target(measurement: Any, path: str | os.PathLike, overwrite: bool) -> Path:
+    """Check a writer's target before any work: not the measurement's own input file (even with
+    ``overwrite=True``: :class:`~roughbrdf.errors.ArgumentError` for ``path``), not a folder
+    (:class:`IsADirectoryError`), not an existing file unless ``overwrite``
+    (:class:`FileExistsError` naming it)."""
+    target = Path(path)
+    meta = getattr(measurement, "meta", {}) or {}
+    for key in ("file", "file_abs"):
+        src = meta.get(key)
+        if isinstance(src, str) and src and same_file(src, target):
+            raise ArgumentError("path", f"{target} is the file this measurement was read from; "
+                                "write to another file (a measurement never replaces its own "
+                                "input, even with overwrite=True)")
+    if target.is_dir():
+        raise IsADirectoryError(f"{target} is a folder, not a file; give a file name")
+    if target.exists() and not overwrite:
+        raise FileExistsError(f"{target} exists; not overwriting it (pass overwrite=True; "
+                              "CLI: --force)")
+    return target
+
+
+def write_table(path: Path, head: str, table: np.ndarray, *, delimiter: str, overwrite: bool,
+                fmt: str = "%.17g") -> None:
+    """Write ``head`` then ``table`` (``numpy.savetxt`` rows, LF line ends) atomically:
+    a temporary file beside ``path`` renamed over it (:func:`roughbrdf.output.staged`), so an
+    error or Ctrl-C leaves the old file or none, never a partial one."""
+    with staged(path, overwrite=overwrite) as fh:
+        fh.write(head)
+        np.savetxt(fh, table, delimiter=delimiter, fmt=fmt, newline="\n")
+
+
+def write_bytes(path: Path, parts: Iterable[bytes], *, overwrite: bool) -> None:
+    """Write ``parts`` one after the other atomically (see :func:`write_table`)."""
+    with staged(path, overwrite=overwrite, binary=True) as fh:
+        for part in parts:
+            fh.write(part)
+
+
+def _header_field(fmt: str) -> Callable[[str], str | None]:
+    mod = importlib.import_module(f"{__package__}.{fmt}")
+    return getattr(mod, "header_field", lambda key: None)
+
+
+def header_not_written(meta: dict[str, Any], target: str, fields: Iterable[str]) -> list[str]:
+    """Header keys of the source file (``meta["header"]``, read from format ``meta["format"]``)
+    that a ``target`` writer, which writes the provenance ``fields`` (``"sample"``...), has no
+    place for. A file written in its own format keeps every key (the writer writes them
+    back), so the list is then empty, as it is for a measurement not read from a file."""
+    src = meta.get("format")
+    header = meta.get("header")
+    if src == target or not isinstance(header, dict) or not header or src not in (
+            "astm", "alta", "csv"):
+        return []
+    field_of = _header_field(str(src))
+    kept = set(fields)
+    return [k for k in header if field_of(k) != LAYOUT and field_of(k) not in kept]
+
+
+def warn_not_written(path: Path, target: str, items: Sequence[str]) -> None:
+    """One :class:`LossyWriteWarning` naming everything the ``target`` file cannot hold."""
+    if items:
+        warnings.warn(f"{path}: the {target} format has no place for {'; '.join(items)} - not "
+                      "written", LossyWriteWarning, stacklevel=_outside_stacklevel())
+
+
+def describe_keys(keys: Sequence[str], source: str) -> str:
+    """``"the astm header keys APERTURE, FILE_NAME"`` for :func:`warn_not_written`."""
+    word = "key" if len(keys) == 1 else "keys"
+    return f"the {source} header {word} {', '.join(keys)}"
+

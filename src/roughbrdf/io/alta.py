@@ -34,7 +34,15 @@ surface). Verified on ``retro-gray-tape.dat``: the retro peaks land at ``theta_r
 Outputs: ``#PARAM_OUT INV_STERADIAN`` -> ``brdf``; ``INV_STERADIAN_COSINE_FACTOR`` ->
 ``brdf_cos`` (BRDF · cos theta_v). A missing or other ``PARAM_OUT`` is an error that asks for
 ``quantity=`` (CLI ``--quantity``); ``retro-gray-tape.dat`` is such a file (it holds
-BRDF · cos theta_v).
+BRDF · cos theta_v). A ``quantity=`` that contradicts ``#PARAM_OUT`` is an error, and so is
+``angles="deg"`` (ALTA angles are radians).
+
+The keys this reader interprets (:data:`KEYS`) may appear once each: a second ``#PARAM_OUT``
+(or ``#DIM``...) is an error naming both lines. Other ``#`` lines are comments. Every ``#`` line
+is kept, as written, in ``meta["header_lines"]`` (and the keys in ``meta["header"]``);
+:func:`write` writes them back when the measurement came from an ALTA file, with ``#DIM``,
+``#VS``, ``#PARAM_IN``, ``#PARAM_OUT``, ``#CHANNELS`` and ``#SAMPLE_COUNT`` rewritten to
+describe the rows written.
 """
 
 from __future__ import annotations
@@ -53,20 +61,28 @@ from ..measurement import QUANTITIES, Measurement
 from ..quantity import Quantity
 from ._common import (
     HALF_PI,
+    LAYOUT,
     ZENITH_SLACK,
     AngleUnit,
     FormatError,
     QuantityClaim,
+    add_key,
     azimuth_rows,
     begin_read,
+    check_fixed_units,
     check_zenith_rows,
     common_frame_from_spherical,
+    describe_keys,
+    header_not_written,
     parse_rows,
+    prepare_target,
     resolve_angle_unit,
     resolve_quantity,
+    warn_not_written,
+    write_table,
 )
 
-__all__ = ["read", "write", "EXTENSIONS", "PARAM_IN"]
+__all__ = ["read", "write", "EXTENSIONS", "PARAM_IN", "KEYS", "header_field"]
 
 EXTENSIONS = (".dat", ".alta")
 
@@ -76,6 +92,14 @@ PARAM_IN = {"ISOTROPIC_TL_TV_PROJ_DPHI": 3, "ISOTROPIC_TV_TL_DPHI": 3,
 #: #PARAM_OUT -> quantity
 _PARAM_OUT = {"INV_STERADIAN": Quantity.BRDF,
               "INV_STERADIAN_COSINE_FACTOR": Quantity.BRDF_COS}
+#: keys that describe the rows (rewritten by :func:`write`)
+_LAYOUT_KEYS = ("DIM", "VS", "PARAM_IN", "PARAM_OUT", "CHANNELS", "SAMPLE_COUNT")
+#: provenance keys -> the field of ``meta`` they feed
+_FIELDS = {"SAMPLE": "sample", "ORIGIN": "instrument", "DATE": "date", "URL": "url"}
+#: the keys this reader interprets: each may appear once
+KEYS = (*_LAYOUT_KEYS, *_FIELDS)
+#: the provenance fields :func:`write` writes for a measurement read from another format
+WRITES = tuple(_FIELDS.values())
 _MISSING_PARAM_OUT = ("no #PARAM_OUT line, so the unit of the values is unknown: say what they "
                       "hold with quantity= (CLI: --quantity): 'brdf' (INV_STERADIAN) or "
                       "'brdf_cos' (INV_STERADIAN_COSINE_FACTOR, BRDF x cos theta_v)")
@@ -90,6 +114,8 @@ class _Header:
     #: data rows (stripped) and their 1-based line numbers
     texts: list[str]
     linenos: list[int]
+    #: every ``#`` line as written (stripped), in order
+    raw: list[str]
 
     def line(self, key: str) -> int | None:
         """1-based line of ``#key`` (None when absent)."""
@@ -126,26 +152,52 @@ def _unquote(text: str) -> str:
 # --------------------------------------------------------------------------------------------
 # phases of read()
 # --------------------------------------------------------------------------------------------
-def _read_header(lines: list[str]) -> _Header:
-    """Header phase: every ``#KEY value`` line (anywhere in the file; a later one replaces an
-    earlier one) and, apart, every other non-blank line as a data row."""
+def header_field(key: str) -> str | None:
+    """What an ALTA header key holds, for a writer of another format: :data:`LAYOUT` (``#DIM``,
+    ``#PARAM_OUT``...: every writer writes its own), the provenance field of ``meta`` it feeds
+    (``"sample"``...), or None (a comment)."""
+    return LAYOUT if key in _LAYOUT_KEYS else _FIELDS.get(key)
+
+
+def _read_header(lines: list[str], path: Path) -> _Header:
+    """Header phase: every ``#KEY value`` line (anywhere in the file; a key of :data:`KEYS`
+    given twice is an error naming both lines, other keys are comments) and, apart, every
+    other non-blank line as a data row."""
     keys: dict[str, str] = {}
     key_lines: dict[str, int] = {}
     texts: list[str] = []
     linenos: list[int] = []
+    raw_lines: list[str] = []
     for i, raw in enumerate(lines):
         s = raw.strip()
         if not s:
             continue
         if s.startswith("#"):
-            key, _, val = s[1:].strip().partition(" ")
-            if key:
-                keys[key.upper()] = val.strip()
-                key_lines[key.upper()] = i + 1
+            raw_lines.append(s)
+            key, *rest = s[1:].split(None, 1) or [""]
+            key, val = key.upper(), rest[0].strip() if rest else ""
+            if key in KEYS:
+                add_key(keys, key_lines, key, val, i + 1, path, shown="#{key}")
+            elif key and key not in keys:
+                keys[key] = val
+                key_lines[key] = i + 1
             continue
         texts.append(s)
         linenos.append(i + 1)
-    return _Header(keys, key_lines, texts, linenos)
+    return _Header(keys, key_lines, texts, linenos, raw_lines)
+
+
+def _whole_number(header: _Header, key: str, path: Path) -> int:
+    """``#key``'s value as a whole number >= 0 (else an error naming its line)."""
+    text = header.keys[key]
+    try:
+        n = int(text.split()[0])
+    except (ValueError, IndexError):
+        n = -1
+    if n < 0:
+        raise FormatError(f"#{key} must be a whole number, got {text!r}", path,
+                          header.line(key))
+    return n
 
 
 def _read_vs(header: _Header, path: Path) -> int:
@@ -200,7 +252,7 @@ def _read_quantity(header: _Header, quantity: str | None, path: Path) -> tuple[Q
             problem=f"#PARAM_OUT {pout} is not a BRDF unit (INV_STERADIAN or "
                     "INV_STERADIAN_COSINE_FACTOR); say what the values hold with quantity= "
                     f"(CLI: --quantity), one of {QUANTITIES}"))
-    return resolve_quantity(quantity, claims, path, agree=True, missing=_MISSING_PARAM_OUT)
+    return resolve_quantity(quantity, claims, path, missing=_MISSING_PARAM_OUT)
 
 
 def _read_rows(header: _Header, layout: _Layout, n_lines: int, path: Path
@@ -214,11 +266,8 @@ def _read_rows(header: _Header, layout: _Layout, n_lines: int, path: Path
     data = parse_rows(header.texts, header.linenos, layout.per_row, path, sep=None,
                       what=f"values (#DIM {nin} {nout}, #VS {vs})")
     if "SAMPLE_COUNT" in header.keys:
-        try:
-            declared_n = int(header.keys["SAMPLE_COUNT"].split()[0])
-        except ValueError:
-            declared_n = None
-        if declared_n is not None and declared_n > data.shape[0]:
+        declared_n = _whole_number(header, "SAMPLE_COUNT", path)
+        if declared_n > data.shape[0]:
             raise FormatError(f"truncated file: #SAMPLE_COUNT is {declared_n} but only "
                               f"{data.shape[0]} rows follow", path, n_lines + 1)
     x = data[:, :nin]
@@ -281,6 +330,9 @@ def _read_channels(header: _Header, nout: int, path: Path) -> list[str]:
     if len(labels) != nout:
         raise FormatError(f"#CHANNELS lists {len(labels)} labels for {nout} outputs", path,
                           header.line("CHANNELS"))
+    if len(set(labels)) != len(labels):
+        raise FormatError(f"#CHANNELS names a channel twice: {labels}", path,
+                          header.line("CHANNELS"))
     return labels
 
 
@@ -295,6 +347,7 @@ def _meta(header: _Header, path: Path, layout: _Layout, quantity_source: str,
 
     return {
         "file": str(path),
+        "file_abs": str(path.resolve()),
         "format": "alta",
         "sample": unquoted("SAMPLE"),
         "instrument": unquoted("ORIGIN"),
@@ -307,10 +360,12 @@ def _meta(header: _Header, path: Path, layout: _Layout, quantity_source: str,
         "original_units": unit.word,
         "zenith_clip_tolerance": ZENITH_SLACK,
         "header": dict(keys),
+        "header_lines": list(header.raw),
     }
 
 
-def read(path: str | os.PathLike, *, quantity: str | None = None, **options: Any) -> Measurement:
+def read(path: str | os.PathLike, *, quantity: str | None = None, angles: str | None = None,
+         **options: Any) -> Measurement:
     """Read an ALTA text file into a :class:`~roughbrdf.measurement.Measurement`.
 
     Parameters
@@ -319,6 +374,8 @@ def read(path: str | os.PathLike, *, quantity: str | None = None, **options: Any
     quantity : str, optional
         What the values hold when the file has no ``#PARAM_OUT`` (or to state it explicitly;
         it must then agree with the file's declaration).
+    angles : {"rad"}, optional
+        ALTA angles are radians; ``"deg"`` contradicts the format (:class:`FormatError`).
 
     Raises
     ------
@@ -327,7 +384,8 @@ def read(path: str | os.PathLike, *, quantity: str | None = None, **options: Any
         line.
     """
     path, lines = begin_read("alta", path, options, quantity)
-    header = _read_header(lines)
+    check_fixed_units("ALTA", angles, None, path, ())
+    header = _read_header(lines, path)
     layout = _read_layout(header, path)
     # ALTA has no unit declaration: its angles are radians
     unit = resolve_angle_unit(None, (), path, default="rad", default_source="ALTA (radians)")
@@ -342,14 +400,71 @@ def read(path: str | os.PathLike, *, quantity: str | None = None, **options: Any
                        meta=_meta(header, path, layout, quantity_source, unit))
 
 
-def write(measurement: Measurement, path: str | os.PathLike) -> None:
+def _channels_line(m: Measurement, had_it: bool) -> str | None:
+    """``#CHANNELS`` value: written when there are several channels, a label other than
+    ``value``, or the source file had one."""
+    bad = [c for c in m.channels if not c or any(ch.isspace() for ch in c)]
+    if bad:
+        raise ValueError(f"channel labels {bad} cannot be ALTA #CHANNELS labels (no spaces)")
+    if had_it or m.n_channels > 1 or m.channels != ["value"]:
+        return " ".join(m.channels)
+    return None
+
+
+def _header_lines(m: Measurement, computed: dict[str, str]) -> list[str]:
+    """The ``#`` lines to write. A measurement read from an ALTA file gets its own lines back,
+    in order, with the keys of ``computed`` rewritten (``#SAMPLE_COUNT`` only where it was);
+    any other measurement gets its provenance and ``computed``."""
+    meta = m.meta
+    raw = meta.get("header_lines") if meta.get("format") == "alta" else None
+    out: list[str] = []
+    if not isinstance(raw, list):
+        for key, field in _FIELDS.items():
+            val = meta.get(field)
+            if val:
+                out.append(f"#{key} {val}" if key == "URL" else f'#{key} "{val}"')
+        raw = []
+    else:
+        if "SAMPLE_COUNT" not in (meta.get("header") or {}):
+            computed = {k: v for k, v in computed.items() if k != "SAMPLE_COUNT"}
+    done: set[str] = set()
+    for line in map(str, raw):
+        words = line[1:].split(None, 1)
+        key = words[0].upper() if words else ""
+        if key in computed:
+            if key not in done:
+                out.append(f"#{key} {computed[key]}")
+                done.add(key)
+            continue
+        out.append(line)
+    out += [f"#{k} {v}" for k, v in computed.items() if k not in done and k != "SAMPLE_COUNT"]
+    return out
+
+
+def write(measurement: Measurement, path: str | os.PathLike, *, overwrite: bool = False
+          ) -> None:
     """Write an ALTA text file: ``#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI``, one output per channel.
 
     ``brdf`` -> ``#PARAM_OUT INV_STERADIAN``; ``brdf_cos``/``bridf`` ->
     ``INV_STERADIAN_COSINE_FACTOR``. A ``relative`` measurement has no ALTA unit and is refused
     (convert it, or write CSV). Uncertainties are written as ``#VS 1`` half-widths.
     Per-sample polarization cannot be stored in ALTA and is refused unless all unpolarized.
+
+    Parameters
+    ----------
+    measurement : Measurement
+    path : str or path-like
+        Never the file the measurement was read from.
+    overwrite : bool
+        Replace an existing file (default: :class:`FileExistsError`).
+
+    Notes
+    -----
+    A measurement read from an ALTA file keeps every ``#`` line it had
+    (``meta["header_lines"]``). Header keys of another format that ALTA has no place for are
+    named in one :class:`~roughbrdf.io.LossyWriteWarning`. The file is written atomically.
     """
+    target = prepare_target(measurement, path, overwrite)
     m = measurement
     quantity = Quantity.parse(m.quantity)
     if not quantity.absolute:
@@ -360,27 +475,18 @@ def write(measurement: Measurement, path: str | os.PathLike) -> None:
                          "one polarization (Measurement.with_polarization) and drop it")
     # library frame -> ALTA: light at azimuth 0, so Δφ = phi - pi (the inverse rotation)
     dphi = m.phi - math.pi
-    x1 = m.theta_r * np.cos(dphi)
-    x2 = m.theta_r * np.sin(dphi)
-    cols = [m.theta_i, x1, x2, m.values]
-    vs = 0
+    cols = [m.theta_i, m.theta_r * np.cos(dphi), m.theta_r * np.sin(dphi), m.values]
     if m.uncertainty is not None:
         cols.append(m.uncertainty)
-        vs = 1
-    table = np.column_stack(cols)
-    lines = []
-    if m.meta.get("sample"):
-        lines.append(f'#SAMPLE "{m.meta["sample"]}"')
-    if m.meta.get("instrument"):
-        lines.append(f'#ORIGIN "{m.meta["instrument"]}"')
-    if m.meta.get("date"):
-        lines.append(f'#DATE "{m.meta["date"]}"')
-    lines += [f"#DIM 3 {m.n_channels}", f"#VS {vs}", "#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI",
-              "#PARAM_OUT " + ("INV_STERADIAN_COSINE_FACTOR" if quantity.cosine_weighted
-                               else "INV_STERADIAN")]
-    if m.n_channels > 1:
-        lines.append("#CHANNELS " + " ".join(m.channels))
-    with open(path, "w", encoding="utf-8", newline="\n") as fh:
-        fh.write("\n".join(lines) + "\n")
-        np.savetxt(fh, table, delimiter="  ", fmt="%.17g")
-
+    had_channels = m.meta.get("format") == "alta" and "CHANNELS" in (m.meta.get("header") or {})
+    computed = {"DIM": f"3 {m.n_channels}", "VS": "1" if m.uncertainty is not None else "0",
+                "PARAM_IN": "ISOTROPIC_TL_TV_PROJ_DPHI",
+                "PARAM_OUT": ("INV_STERADIAN_COSINE_FACTOR" if quantity.cosine_weighted
+                              else "INV_STERADIAN"),
+                "CHANNELS": _channels_line(m, had_channels), "SAMPLE_COUNT": str(m.n_samples)}
+    lines = _header_lines(m, {k: v for k, v in computed.items() if v is not None})
+    lost = header_not_written(m.meta, "alta", WRITES)
+    write_table(target, "\n".join(lines) + "\n", np.column_stack(cols), delimiter="  ",
+                overwrite=overwrite)
+    if lost:
+        warn_not_written(target, "ALTA", [describe_keys(lost, str(m.meta.get("format")))])

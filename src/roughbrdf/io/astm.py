@@ -30,7 +30,13 @@ Conventions verified on the Mini-Diff files (``../shared/data/minidiff``):
 * the pole ``theta_s = 0`` is stored once per incidence (``meta["pole_rows"]``).
 
 ``MEAS_NAME`` gives the quantity: BRDF/BSDF -> ``brdf``; CCBRDF (cosine-corrected) ->
-``brdf_cos``; others need ``quantity=``.
+``brdf_cos``; others need ``quantity=``. A ``quantity=`` or ``angles=`` option must agree with
+what the file declares (it supplies what the file does not say); a key given twice, or two
+declarations of the angle unit or the polarization that disagree, are errors naming both lines.
+
+Every header key is kept, as read, in ``meta["header"]``; :func:`write` writes them back when
+the measurement came from an ASTM file (only ``NUM_POINTS``, ``VARS``, ``MEAS_NAME``, the unit
+and polarization declarations are rewritten to describe the rows written).
 """
 
 from __future__ import annotations
@@ -48,22 +54,29 @@ from ..fresnel import polarization_angle
 from ..measurement import QUANTITIES, Measurement
 from ..quantity import Quantity
 from ._common import (
+    LAYOUT,
     AngleUnit,
     FormatError,
     QuantityClaim,
     UnitClaim,
-    angle_factor,
+    add_key,
     azimuth_rows,
     begin_read,
     check_zenith_rows,
     common_frame_from_spherical,
     data_lines,
+    describe_keys,
+    header_not_written,
     parse_rows,
+    prepare_target,
     resolve_angle_unit,
     resolve_quantity,
+    unit_word,
+    warn_not_written,
+    write_table,
 )
 
-__all__ = ["read", "write", "EXTENSIONS"]
+__all__ = ["read", "write", "EXTENSIONS", "header_field"]
 
 EXTENSIONS = (".astm",)
 
@@ -81,6 +94,12 @@ _WAVELENGTH = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*nm\s*$", re.IGNORECASE)
 _QUANTITY = {"BRDF": Quantity.BRDF, "BSDF": Quantity.BRDF, "CCBRDF": Quantity.BRDF_COS,
              "CC_BRDF": Quantity.BRDF_COS, "COSINE_CORRECTED_BRDF": Quantity.BRDF_COS}
 _NO_MEAS_NAME = "no MEAS_NAME"
+_POLARIZATION_KEYS = ("POLARIZATION", "SOURCE_POLARIZATION", "INCIDENT_POLARIZATION")
+#: header key -> the provenance field of ``meta`` it feeds (what other formats can write)
+_FIELDS = {"SAMPLE_NAME": "sample", "LAB_NAME": "instrument", "SYSTEM_NAME": "instrument",
+           "MEAS_DATE": "date", "MEAS_TIME": "date", "FILE_NAME": "file_name_declared"}
+#: the provenance fields :func:`write` writes for a measurement read from another format
+WRITES = ("sample", "instrument", "date")
 #: beyond this an azimuth in radians is taken for degrees
 _TWO_PI_SLACK = 2 * math.pi + 1e-6
 
@@ -150,10 +169,9 @@ def _read_header(lines: list[str], path: Path) -> _Header:
         try:
             float(first)
         except ValueError:
-            key, _, val = s.partition(" ")
-            key = key.strip().rstrip(":=").upper()
-            keys[key] = val.strip()
-            key_lines[key] = i + 1
+            key, *rest = s.split(None, 1)
+            add_key(keys, key_lines, key.rstrip(":=").upper(), rest[0].strip() if rest else "",
+                    i + 1, path)
             continue
         data_start = i
         break
@@ -164,16 +182,32 @@ def _read_header(lines: list[str], path: Path) -> _Header:
     return _Header(keys, key_lines, data_start)
 
 
-def _header_unit_claim(header: _Header) -> UnitClaim | None:
-    """The header's angle-unit declaration: the first key containing ``UNIT`` (with ``ANG``, or
+def _is_unit_key(key: str) -> bool:
+    """Whether a header key can declare the angle unit (``ANGLE_UNITS``, ``UNITS``...)."""
+    return ("UNIT" in key and ("ANG" in key or key in ("UNITS", "UNIT"))) or \
+        key in ("ANGLES", "ANGLE")
+
+
+def _header_unit_claims(header: _Header) -> list[UnitClaim]:
+    """The header's angle-unit declarations: every key containing ``UNIT`` (with ``ANG``, or
     ``UNIT(S)`` alone) or ``ANGLE(S)`` whose value starts with ``deg``/``rad``."""
+    claims = []
     for key, val in header.keys.items():
-        if ("UNIT" in key and ("ANG" in key or key in ("UNITS", "UNIT"))) or \
-                key in ("ANGLES", "ANGLE"):
+        if _is_unit_key(key):
             word = _unit_word(val.split()[0]) if val.strip() else None
             if word is not None:
-                return UnitClaim((word,), f"header {key}", key, header.line(key))
-    return None
+                claims.append(UnitClaim((word,), f"header {key}", f"{key} {val}",
+                                        header.line(key)))
+    return claims
+
+
+def header_field(key: str) -> str | None:
+    """What an ASTM header key holds, for a writer of another format: :data:`LAYOUT` (column
+    names, count, quantity, unit and polarization declarations: every writer writes its own),
+    the provenance field of ``meta`` it feeds (``"sample"``...), or None."""
+    if key in ("NUM_POINTS", "VARS", "MEAS_NAME", *_POLARIZATION_KEYS) or _is_unit_key(key):
+        return LAYOUT
+    return _FIELDS.get(key)
 
 
 def _read_units(header: _Header, angles: str | None, path: Path
@@ -183,6 +217,8 @@ def _read_units(header: _Header, angles: str | None, path: Path
     else the units in the angle names of VARS (all alike), else radians."""
     names: list[str] = []
     name_units: list[str] = []
+    if not _split_vars(header.keys["VARS"]):
+        raise FormatError("VARS lists no column names", path, header.line("VARS"))
     for nm in _split_vars(header.keys["VARS"]):
         m = _UNIT_IN_NAME.match(nm)
         unit = m.group("unit").strip().lower().rstrip("s") if m else ""
@@ -193,9 +229,14 @@ def _read_units(header: _Header, angles: str | None, path: Path
         word = _unit_word(unit)
         if names[-1].lower() in _ANGLE_NAMES and word is not None:  # always a unit word here
             name_units.append(word)
-    claims = [c for c in (_header_unit_claim(header),) if c is not None]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise FormatError(f"VARS names the column(s) {dup} twice: {header.keys['VARS']!r}",
+                          path, header.line("VARS"))
+    claims = _header_unit_claims(header)
     if name_units:
-        claims.append(UnitClaim(tuple(name_units), "VARS names", "VARS", header.line("VARS")))
+        claims.append(UnitClaim(tuple(name_units), "VARS names", "the units in VARS",
+                                header.line("VARS")))
     unit = resolve_angle_unit(angles, claims, path, default="rad",
                               default_source="default (radians)")
     return names, unit
@@ -205,11 +246,15 @@ def _read_num_points(header: _Header, path: Path) -> int | None:
     """The ``NUM_POINTS`` keyword, if any (a number, else an error naming its line)."""
     if "NUM_POINTS" not in header.keys:
         return None
+    text = header.keys["NUM_POINTS"]
     try:
-        return int(float(header.keys["NUM_POINTS"].split()[0]))
+        n = float(text.split()[0])
     except (ValueError, IndexError):
-        raise FormatError(f"NUM_POINTS is not a number: {header.keys['NUM_POINTS']!r}", path,
-                          header.line("NUM_POINTS")) from None
+        n = math.nan
+    if not (math.isfinite(n) and n >= 0 and n.is_integer()):
+        raise FormatError(f"NUM_POINTS must be a whole number of rows, got {text!r}", path,
+                          header.line("NUM_POINTS"))
+    return int(n)
 
 
 def _read_columns(names: list[str], first_row: str, header: _Header) -> _Columns:
@@ -286,7 +331,8 @@ def _read_angles(data: np.ndarray, cols: _Columns, unit: AngleUnit, ln: np.ndarr
     beyond = (np.abs(out["phi_i"]) > _TWO_PI_SLACK) | (np.abs(out["phi_s"]) > _TWO_PI_SLACK)
     if unit.word == "rad" and beyond.any():
         raise FormatError("azimuth beyond 2 pi rad: the angles look like degrees; declare the "
-                          "unit (angles='deg' / --angles deg)", path,
+                          "unit (ANGLE_UNITS deg in the header, or angles='deg'; CLI: "
+                          "--angles-in deg)", path,
                           int(ln[int(np.flatnonzero(beyond)[0])]))
     return out
 
@@ -305,29 +351,45 @@ def _read_quantity(header: _Header, quantity: str | None, path: Path) -> Quantit
                     f"one of {QUANTITIES}"))
     q, source = resolve_quantity(quantity, claims, path, default=Quantity.BRDF,
                                  default_source=_NO_MEAS_NAME)
-    if source == _NO_MEAS_NAME:
+    if source == _NO_MEAS_NAME and quantity is None:
         header.quirks.append("no MEAS_NAME: values taken as BRDF (sr^-1)")
     return q
 
 
+def _polarization_value(key: str, val: str, unit: AngleUnit, path: Path,
+                        line: int | None) -> float:
+    """One polarization declaration: an angle in the file's unit, or ``s``/``p``/
+    ``unpolarized`` (NaN; also ``nan``)."""
+    try:
+        g = float(val) * unit.factor
+    except ValueError:
+        try:
+            return polarization_angle(val.lower())
+        except ValueError as exc:
+            raise FormatError(f"{key}: {exc}", path, line) from None
+    if math.isinf(g):
+        raise FormatError(f"{key} {val!r} is not a finite angle", path, line)
+    return g
+
+
 def _read_polarization(header: _Header, unit: AngleUnit, n: int, path: Path
                        ) -> np.ndarray | None:
-    """Header phase, polarization: the first non-empty ``POLARIZATION``,
-    ``SOURCE_POLARIZATION`` or ``INCIDENT_POLARIZATION`` - an angle in the file's unit or
-    ``s``/``p``/``unpolarized``."""
-    for key in ("POLARIZATION", "SOURCE_POLARIZATION", "INCIDENT_POLARIZATION"):
+    """Header phase, polarization: ``POLARIZATION``, ``SOURCE_POLARIZATION`` or
+    ``INCIDENT_POLARIZATION`` - an angle in the file's unit or ``s``/``p``/``unpolarized``;
+    several must agree."""
+    found: list[tuple[str, float]] = []
+    for key in _POLARIZATION_KEYS:
         val = header.keys.get(key, "").strip()
         if not val:
             continue
-        try:
-            g = float(val) * unit.factor
-        except ValueError:
-            try:
-                g = polarization_angle(val.lower())
-            except ValueError as exc:
-                raise FormatError(str(exc), path, header.line(key)) from None
-        return np.full(n, g)
-    return None
+        g = _polarization_value(key, val, unit, path, header.line(key))
+        if found and not (g == found[0][1] or (math.isnan(g) and math.isnan(found[0][1]))):
+            first = found[0][0]
+            raise FormatError(f"{first} {header.keys[first]!r} (line {header.line(first)}) "
+                              f"contradicts {key} {val!r} (line {header.line(key)})", path,
+                              header.line(key))
+        found.append((key, g))
+    return np.full(n, found[0][1]) if found else None
 
 
 def _meta(header: _Header, path: Path, channels: list[str], unit: AngleUnit,
@@ -345,6 +407,7 @@ def _meta(header: _Header, path: Path, channels: list[str], unit: AngleUnit,
     wavelengths = [float(m.group(1)) if m else None for m in found]
     return {
         "file": str(path),
+        "file_abs": str(path.resolve()),
         "format": "astm",
         "sample": sample,
         "instrument": instrument or None,
@@ -401,45 +464,151 @@ def read(path: str | os.PathLike, *, angles: str | None = None, quantity: str | 
                        polarization=polarization, original=original, meta=meta)
 
 
-def write(measurement: Measurement, path: str | os.PathLike, *, angles: str = "rad") -> None:
+def _uniform_polarization(m: Measurement) -> float | None:
+    """The one incident polarization of every sample (radians; NaN = unpolarized), None when
+    the measurement has none; ``ValueError`` when the samples differ (ASTM has one header
+    value)."""
+    if m.polarization is None or m.n_samples == 0:
+        return None
+    p = np.asarray(m.polarization, dtype=float)
+    if np.isnan(p).all():
+        return math.nan
+    if np.isnan(p).any() or np.ptp(p) > 0:
+        raise ValueError("an ASTM file holds one polarization for all its rows (header "
+                         "POLARIZATION); these samples differ: write CSV, or select one "
+                         "polarization (Measurement.with_polarization)")
+    return float(p[0])
+
+
+def _polarization_text(gamma: float, factor: float, as_read: str | None) -> str:
+    """The header value for ``gamma``: the value as read when it says the same, else
+    ``unpolarized`` or the angle in the written unit."""
+    if as_read:
+        try:
+            same = polarization_angle(as_read.lower())
+        except ValueError:
+            same = None
+        if same is not None and (same == gamma or (math.isnan(same) and math.isnan(gamma))):
+            return as_read
+    return "unpolarized" if math.isnan(gamma) else f"{gamma * factor:.17g}"
+
+
+def _meas_name(quantity: Quantity, as_read: str | None) -> str:
+    """``MEAS_NAME``: the value as read when it names this quantity, else BRDF or CCBRDF."""
+    if as_read:
+        known = _QUANTITY.get(as_read.upper().replace(" ", "_").replace("-", "_"))
+        if known is not None and (known == quantity or (known.cosine_weighted and
+                                                        quantity.cosine_weighted)):
+            return as_read
+    return "CCBRDF" if quantity.cosine_weighted else "BRDF"
+
+
+def _insert_before_rows(entries: list[tuple[str, str]], key: str, value: str) -> None:
+    """Insert a key before ``NUM_POINTS``/``VARS`` (the keys that end a header)."""
+    at = next((k for k, (name, _) in enumerate(entries) if name in ("NUM_POINTS", "VARS")),
+              len(entries))
+    entries.insert(at, (key, value))
+
+
+def _header_entries(m: Measurement, target: Path, unit: str, quantity: Quantity,
+                    gamma: float | None) -> list[tuple[str, str]]:
+    """The header to write, as (key, value) pairs in order. A measurement read from an ASTM
+    file gets its own header back, key for key, with the keys that describe the rows
+    rewritten; any other measurement gets the provenance it has."""
+    factor = 180.0 / math.pi if unit == "deg" else 1.0
+    names = ",".join(["theta_i", "phi_i", "theta_s", "phi_s", *m.channels])
+    meta = m.meta
+    source = meta.get("header") if meta.get("format") == "astm" else None
+    if not isinstance(source, dict):
+        entries = [(k, str(v)) for k, v in (("LAB_NAME", meta.get("instrument")),
+                                            ("SAMPLE_NAME", meta.get("sample") or target.stem),
+                                            ("MEAS_NAME", _meas_name(quantity, None)),
+                                            ("FILE_NAME", target.name),
+                                            ("MEAS_DATE", meta.get("date"))) if v]
+        source = {}
+    else:
+        entries = []
+    for key, val in source.items():
+        if key == "MEAS_NAME":
+            val = _meas_name(quantity, val)
+        elif key == "NUM_POINTS":
+            val = str(m.n_samples)
+        elif key == "VARS":
+            val = names
+        elif _is_unit_key(key) and val.strip() and _unit_word(val.split()[0]):
+            val = unit
+        elif key in _POLARIZATION_KEYS and val.strip():
+            val = _polarization_text(math.nan if gamma is None else gamma, factor, val)
+        entries.append((key, val))
+    present = {k for k, _ in entries}
+    if "MEAS_NAME" not in present:
+        _insert_before_rows(entries, "MEAS_NAME", _meas_name(quantity, None))
+    declared = [k for k, v in entries if _is_unit_key(k) and v == unit]
+    if unit == "deg" and not declared:
+        _insert_before_rows(entries, "ANGLE_UNITS", "deg")
+    if gamma is not None and not present & set(_POLARIZATION_KEYS):
+        _insert_before_rows(entries, "POLARIZATION", _polarization_text(gamma, factor, None))
+    for key, val in (("NUM_POINTS", str(m.n_samples)), ("VARS", names)):
+        if key not in present:
+            entries.append((key, val))
+    return entries
+
+
+def write(measurement: Measurement, path: str | os.PathLike, *, angles: str = "rad",
+          overwrite: bool = False) -> None:
     """Write an ASTM E1392-style file (7+ columns, VARS lists every column, phi_i = 180 deg).
 
     Parameters
     ----------
     measurement : Measurement
         Only absolute quantities: ``brdf`` (MEAS_NAME BRDF) and the cosine-weighted ``brdf_cos``
-        / ``bridf`` (MEAS_NAME CCBRDF).
+        / ``bridf`` (MEAS_NAME CCBRDF); one polarization for all samples (``POLARIZATION``).
     path : str or path-like
+        Never the file the measurement was read from.
     angles : {"rad", "deg"}
         Angles are radians (the Mini-Diff convention) unless ``angles="deg"``, which is declared
         in an ``ANGLE_UNITS`` header line.
+    overwrite : bool
+        Replace an existing file (default: :class:`FileExistsError`).
+
+    Notes
+    -----
+    A measurement read from an ASTM file keeps every header key it had (``meta["header"]``).
+    What the file has no place for - another format's header keys without an ASTM
+    counterpart, uncertainties - is named in one :class:`~roughbrdf.io.LossyWriteWarning`.
+    The file is written atomically (a temporary file renamed over ``path``).
+
+    Raises
+    ------
+    FileExistsError
+        ``path`` exists and ``overwrite`` is false.
+    roughbrdf.errors.ArgumentError
+        ``path`` is the measurement's own input file.
+    ValueError
+        A relative measurement, per-sample polarizations, or channel labels that cannot be
+        VARS names.
     """
+    target = prepare_target(measurement, path, overwrite)
     m = measurement
     quantity = Quantity.parse(m.quantity)
     if not quantity.absolute:
         raise ValueError("ASTM E1392 holds absolute BRDF; a 'relative' measurement cannot be "
                          "written as .astm (use CSV)")
-    factor = 180.0 / math.pi if angle_factor(angles) != 1.0 else 1.0
-    meas_name = "CCBRDF" if quantity.cosine_weighted else "BRDF"
-    bad = [c for c in m.channels if re.search(r"[\s,;]", c)]
+    unit = unit_word(angles)
+    bad = [c for c in m.channels if re.search(r"[\s,;()\[\]]", c) or
+           c.lower() in _ANGLE_NAMES or not c]
     if bad:
-        raise ValueError(f"channel labels with spaces or commas cannot be ASTM VARS: {bad}")
-    meta = m.meta
-    lines = []
-    if meta.get("instrument"):
-        lines.append(f"LAB_NAME {meta['instrument']}")
-    lines.append(f"SAMPLE_NAME {meta.get('sample') or Path(path).stem}")
-    lines.append(f"MEAS_NAME {meas_name}")
-    lines.append(f"FILE_NAME {Path(path).name}")
-    if meta.get("date"):
-        lines.append(f"MEAS_DATE {meta['date']}")
-    if factor != 1.0:
-        lines.append("ANGLE_UNITS deg")
-    lines.append(f"NUM_POINTS {m.n_samples}")
-    lines.append("VARS " + ",".join(["theta_i", "phi_i", "theta_s", "phi_s", *m.channels]))
-    phi_s = np.mod(m.phi, 2 * math.pi)
+        raise ValueError(f"channel labels {bad} cannot be ASTM VARS names (no spaces, commas, "
+                         "brackets or angle names)")
+    gamma = _uniform_polarization(m)
+    entries = _header_entries(m, target, unit, quantity, gamma)
+    lost = header_not_written(m.meta, "astm", WRITES)
+    items = [describe_keys(lost, str(m.meta.get("format")))] if lost else []
+    if m.uncertainty is not None:
+        items.append("the uncertainties (sigma)")
+    factor = 180.0 / math.pi if unit == "deg" else 1.0
     cols = np.column_stack([m.theta_i * factor, np.full(m.n_samples, math.pi * factor),
-                            m.theta_r * factor, phi_s * factor, m.values])
-    with open(path, "w", encoding="utf-8", newline="\n") as fh:
-        fh.write("\n".join(lines) + "\n\n")
-        np.savetxt(fh, cols, delimiter=",", fmt="%.17g")
+                            m.theta_r * factor, np.mod(m.phi, 2 * math.pi) * factor, m.values])
+    head = "".join(f"{k} {v}".rstrip() + "\n" for k, v in entries) + "\n"
+    write_table(target, head, cols, delimiter=",", overwrite=overwrite)
+    warn_not_written(target, "ASTM", items)

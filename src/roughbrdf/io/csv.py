@@ -37,10 +37,20 @@ Columns (comma separated, first non-``#`` line; order free):
 
 Non-finite values in channels (``nan``, ``inf``) are read and counted by
 ``Measurement.validate``; a non-finite angle is an error naming the line.
+
+A header key given twice, unit declarations that disagree (``# angles:``, ``# units:``, the
+column suffixes), and an ``angles=`` or ``quantity=`` option that contradicts the file are
+errors naming both places; the options supply what the file does not say.
+
+Every header key is kept, as written, in ``meta["header"]`` (and, lower-cased, in ``meta``);
+:func:`write` writes them all back when the measurement came from a CSV file (``angles`` and
+``quantity`` rewritten to describe the rows written). A measurement read from another format
+gets that file's header as JSON in ``# source_header:``, so nothing of it is lost.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import re
@@ -54,21 +64,25 @@ from ..fresnel import polarization_angle
 from ..measurement import QUANTITIES, Measurement
 from ..quantity import Quantity
 from ._common import (
+    LAYOUT,
     AngleUnit,
     FormatError,
     QuantityClaim,
     UnitClaim,
-    angle_factor,
+    add_key,
     azimuth_rows,
     begin_read,
     check_zenith_rows,
     data_lines,
     parse_rows,
+    prepare_target,
     resolve_angle_unit,
     resolve_quantity,
+    unit_word,
+    write_table,
 )
 
-__all__ = ["read", "write", "EXTENSIONS", "TAG"]
+__all__ = ["read", "write", "EXTENSIONS", "TAG", "header_field"]
 
 EXTENSIONS = (".csv",)
 TAG = "roughbrdf-csv"
@@ -77,6 +91,8 @@ _ANGLES = ("theta_i", "theta_r", "phi")
 _SUFFIX = re.compile(r"^(theta_i|theta_r|phi|polarization)_(deg|rad)$")
 #: header keys that declare the angle unit, first found wins
 _UNIT_KEYS = ("angles", "angle_units", "units")
+#: provenance keys taken from ``meta`` when writing (an edited ``meta["sample"]`` is written)
+_PROVENANCE = ("sample", "instrument", "date", "relative_to")
 _MISSING_UNITS = ("missing angle units: add a header line '# angles: deg' or '# angles: rad' "
                   "before the column names (or name the columns theta_i_deg, ...; or pass "
                   "angles=)")
@@ -92,6 +108,8 @@ class _Header:
     lines: dict[str, int]
     #: index (0-based) of the column-name line
     col_line: int
+    #: key (lower case) -> the key as written
+    spelled: dict[str, str]
 
     def line(self, key: str) -> int | None:
         """1-based line of ``# key:`` (None when absent)."""
@@ -131,23 +149,33 @@ def _read_header(lines: list[str], path: Path) -> _Header:
     are ignored."""
     keys: dict[str, str] = {}
     key_lines: dict[str, int] = {}
+    spelled: dict[str, str] = {}
     for i, raw in enumerate(lines):
         s = raw.strip()
         if not s:
             continue
         if not s.startswith("#"):
-            return _Header(keys, key_lines, i)
+            return _Header(keys, key_lines, i, spelled)
         body = s.lstrip("#").strip()
         if body.startswith(TAG):
-            keys["format_version"] = body[len(TAG):].strip() or str(VERSION)
-            key_lines["format_version"] = i + 1
+            add_key(keys, key_lines, "format_version", body[len(TAG):].strip() or str(VERSION),
+                    i + 1, path, shown=f"the '# {TAG}' line")
             continue
         key, sep, val = body.partition(":")
         if sep:
-            keys[key.strip().lower()] = val.strip()
-            key_lines[key.strip().lower()] = i + 1
+            add_key(keys, key_lines, key.strip().lower(), val.strip(), i + 1, path,
+                    shown="'# {key}:'")
+            spelled[key.strip().lower()] = key.strip()
     raise FormatError("no column-name line (e.g. 'theta_i,theta_r,phi,brdf')", path,
                       len(lines) + 1)
+
+
+def header_field(key: str) -> str | None:
+    """What a CSV header key holds, for a writer of another format: :data:`LAYOUT` (the unit
+    and quantity declarations: every writer writes its own), else the field of ``meta`` it is
+    kept in (its lower-case name)."""
+    k = key.strip().lower()
+    return LAYOUT if k in (*_UNIT_KEYS, "quantity", "format_version") else k
 
 
 def _read_column_names(lines: list[str], header: _Header, path: Path) -> _Columns:
@@ -183,16 +211,13 @@ def _read_units(header: _Header, cols: _Columns, angles: str | None, path: Path)
     """Units phase: the ``angles=`` option, else ``# angles:`` (or ``angle_units``/``units``),
     which the column suffixes must agree with, else the column suffixes; a file with neither
     is refused (there is no default unit)."""
-    claims = []
-    key = next((k for k in _UNIT_KEYS if header.keys.get(k)), None)
-    if key is not None:
-        claims.append(UnitClaim((header.keys[key],), f"header {key}",
-                                f"'# angles: {header.keys[key]}'", header.line(key)))
+    claims = [UnitClaim((header.keys[k],), f"header {k}", f"'# {k}: {header.keys[k]}'",
+                        header.line(k)) for k in _UNIT_KEYS if header.keys.get(k)]
     if cols.suffix_units:
         claims.append(UnitClaim(tuple(cols.suffix_units.values()), "column names",
                                 f"the column names {cols.names}", cols.line))
-    return resolve_angle_unit(angles, claims, path, default=None, agree=True,
-                              missing=_MISSING_UNITS, missing_line=cols.line)
+    return resolve_angle_unit(angles, claims, path, default=None, missing=_MISSING_UNITS,
+                              missing_line=cols.line)
 
 
 def _read_roles(cols: _Columns, path: Path) -> _Roles:
@@ -222,9 +247,9 @@ def _read_roles(cols: _Columns, path: Path) -> _Roles:
 
 def _read_quantity(header: _Header, roles: _Roles, quantity: str | None, path: Path,
                    line: int) -> Quantity:
-    """Quantity phase: ``# quantity:`` (must be a quantity even when the option is given), the
-    ``quantity=`` option first, else the header, else the name of a single value column
-    (``brdf``...); required."""
+    """Quantity phase: ``# quantity:`` (must be a quantity; a ``quantity=`` option must agree
+    with it), else the option, else the name of a single value column (``brdf``...); one of
+    them is required."""
     claims = []
     declared = header.keys.get("quantity")
     if declared is not None:
@@ -234,11 +259,12 @@ def _read_quantity(header: _Header, roles: _Roles, quantity: str | None, path: P
             raise FormatError(f"quantity {declared!r} is not one of {QUANTITIES}", path,
                               header.line("quantity")) from None
         claims.append(QuantityClaim(q, f"# quantity: {declared}", header.line("quantity")))
+    fallback = None
     if len(roles.channels) == 1 and roles.channels[0].lower() in QUANTITIES:
-        claims.append(QuantityClaim(Quantity(roles.channels[0].lower()),
-                                    f"column name {roles.channels[0]!r}", line))
-    q, _ = resolve_quantity(quantity, claims, path, missing=_MISSING_QUANTITY,
-                            missing_line=line)
+        fallback = QuantityClaim(Quantity(roles.channels[0].lower()),
+                                 f"column name {roles.channels[0]!r}", line)
+    q, _ = resolve_quantity(quantity, claims, path, fallback=fallback,
+                            missing=_MISSING_QUANTITY, missing_line=line)
     return q
 
 
@@ -266,6 +292,9 @@ def _read_polarization(texts: list[str], linenos: list[int], cols: _Columns, pol
                 except ValueError:
                     raise FormatError(f"polarization {tok!r} is neither an angle nor s/p/"
                                       "unpolarized", path, linenos[k]) from None
+            if math.isinf(cache[tok]):
+                raise FormatError(f"polarization {tok!r} is not a finite angle", path,
+                                  linenos[k])
         polarization[k] = cache[tok]
     return [",".join(r[:pol_col] + ["0"] + r[pol_col + 1:]) for r in rows], polarization
 
@@ -307,12 +336,14 @@ def _meta(header: _Header, path: Path, unit: AngleUnit, has_original: bool) -> d
                             if k not in ("angles", "quantity", "format_version")}
     meta.update({
         "file": str(path),
+        "file_abs": str(path.resolve()),
         "format": "csv",
         "sample": keys.get("sample"),
         "instrument": keys.get("instrument"),
         "date": keys.get("date"),
         "angle_units": unit.word,
         "format_version": keys.get("format_version"),
+        "header": {header.spelled[k]: v for k, v in keys.items() if k in header.spelled},
     })
     if has_original:
         meta["original_units"] = keys.get("original_units", "as in the source file")
@@ -351,8 +382,56 @@ def _clean(text: Any) -> str:
     return " ".join(str(text).split())
 
 
+def _header_from_csv(meta: dict[str, Any], unit: str, quantity: str) -> list[str]:
+    """The header of a measurement read from a CSV file: its own keys, in order, with the unit
+    and quantity declarations rewritten (and added where the file had none)."""
+    head = []
+    seen = set()
+    for key, val in meta["header"].items():
+        k = key.lower()
+        seen.add(k)
+        if k in _UNIT_KEYS:
+            val = unit
+        elif k == "quantity":
+            val = quantity
+        elif k in _PROVENANCE and isinstance(meta.get(k), str):
+            val = meta[k]
+        head.append(f"# {key}: {_clean(val)}")
+    if not seen & set(_UNIT_KEYS):
+        head.insert(0, f"# angles: {unit}")
+    if "quantity" not in seen:
+        head.insert(1, f"# quantity: {quantity}")
+    return head
+
+
+def _header(m: Measurement, unit: str, orig_keys: list[str]) -> list[str]:
+    """Every ``#`` line: the tag, the unit and quantity, the provenance, the source file's
+    header (kept key for key from a CSV file, as JSON ``source_header`` from another
+    format)."""
+    meta = m.meta
+    quantity = Quantity.parse(m.quantity).value
+    from_csv = meta.get("format") == "csv" and isinstance(meta.get("header"), dict)
+    head = [f"# {TAG} {VERSION}"]
+    if from_csv:
+        head += _header_from_csv(meta, unit, quantity)
+    else:
+        head += [f"# angles: {unit}", f"# quantity: {quantity}"]
+        head += [f"# {k}: {_clean(meta[k])}" for k in _PROVENANCE if meta.get(k)]
+    present = {line[2:].partition(":")[0].strip().lower() for line in head}
+    if meta.get("file") and "source_file" not in present:
+        head.append(f"# source_file: {_clean(meta.get('source_file', meta['file']))}")
+    if meta.get("format") and "source_format" not in present:
+        head.append(f"# source_format: {_clean(meta.get('source_format', meta['format']))}")
+    if orig_keys and meta.get("original_units") and "original_units" not in present:
+        head.append(f"# original_units: {_clean(meta['original_units'])}")
+    if not from_csv and isinstance(meta.get("header"), dict) and meta["header"]:
+        head.append("# source_header: " + json.dumps({str(k): str(v) for k, v in
+                                                      meta["header"].items()}))
+    return head
+
+
 def write(measurement: Measurement, path: str | os.PathLike, *, angles: str = "deg",
-          original: bool = True) -> None:
+          original: bool = True, overwrite: bool = False) -> None:
     """Write a roughbrdf CSV file (layout in the module docstring).
 
     Parameters
@@ -360,13 +439,23 @@ def write(measurement: Measurement, path: str | os.PathLike, *, angles: str = "d
     measurement : Measurement
         Any quantity; ``# quantity:`` gets its plain name (``brdf``...).
     path : str or path-like
+        Never the file the measurement was read from.
     angles : {"deg", "rad"}
         Unit of the angle and polarization columns, declared in ``# angles:``.
     original : bool
         Add the source file's one-dimensional numeric angle columns as ``orig_<name>``.
+    overwrite : bool
+        Replace an existing file (default: :class:`FileExistsError`).
+
+    Notes
+    -----
+    A measurement read from a CSV file keeps every header key it had; one read from another
+    format gets that file's header as JSON in ``# source_header:``. The file is written
+    atomically (a temporary file renamed over ``path``).
     """
+    target = prepare_target(measurement, path, overwrite)
     m = measurement
-    unit = "deg" if angle_factor(angles) != 1.0 else "rad"
+    unit = unit_word(angles)
     factor = 180.0 / math.pi if unit == "deg" else 1.0
     reserved = {*_ANGLES, "polarization"}
     for c in m.channels:
@@ -385,23 +474,10 @@ def write(measurement: Measurement, path: str | os.PathLike, *, angles: str = "d
     if original:
         for k, v in m.original.items():
             a = np.asarray(v)
-            if a.ndim == 1 and np.issubdtype(a.dtype, np.number) and "," not in k:
+            if a.ndim == 1 and np.issubdtype(a.dtype, np.number) and "," not in k and \
+                    f"orig_{k}" not in names and k.strip() == k and k:
                 orig_keys.append(k)
                 names.append(f"orig_{k}")
                 cols.append(a.astype(float))
-    head = [f"# {TAG} {VERSION}", f"# angles: {unit}",
-            f"# quantity: {Quantity.parse(m.quantity).value}"]
-    meta = m.meta
-    for key in ("sample", "instrument", "date", "relative_to"):
-        if meta.get(key):
-            head.append(f"# {key}: {_clean(meta[key])}")
-    if meta.get("file"):
-        head.append(f"# source_file: {_clean(meta.get('source_file', meta['file']))}")
-    if meta.get("format"):
-        head.append(f"# source_format: {_clean(meta.get('source_format', meta['format']))}")
-    if orig_keys and meta.get("original_units"):
-        head.append(f"# original_units: {_clean(meta['original_units'])}")
-    table = np.column_stack(cols)
-    with open(path, "w", encoding="utf-8", newline="\n") as fh:
-        fh.write("\n".join(head) + "\n" + ",".join(names) + "\n")
-        np.savetxt(fh, table, delimiter=",", fmt="%.17g")
+    head = "\n".join(_header(m, unit, orig_keys)) + "\n" + ",".join(names) + "\n"
+    write_table(target, head, np.column_stack(cols), delimiter=",", overwrite=overwrite)

@@ -30,11 +30,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .. import _kernels
-from ..geometry import check_angles
+from ..errors import ArgumentError
+from ..geometry import check_angles, check_broadcast
 from ..polarization import Polarization
 from ..quantity import Quantity
 from ..registry import Registry, unknown_name
-from .parameters import Parameter
+from .parameters import Parameter, ReadOnlyDict
 
 __all__ = ["Model", "PreparedGeometry", "SumModel", "components", "MODELS", "register"]
 
@@ -78,6 +79,26 @@ class Model:
     parameters as a tuple of floats) and ``_drive`` (the compiled driver, see
     :mod:`roughbrdf._kernels.compile`); a model with its own evaluation path overrides
     ``_kernel`` instead.
+
+    A model is an **immutable value**: its parameters and options are set when it is built
+    (validated against each parameter's physical domain) and never change afterwards. A sum
+    keeps copies of its components, a fit keeps the model it started from and the fitted one,
+    and compiled evaluations pack the values once; changing a model in place would silently
+    leave those out of step. So assignment raises instead of doing nothing:
+    ``m.params["e"] = 0.1`` (and ``m.options[...] = ...``) raises ``TypeError`` and ``m.e = 0.1``
+    (any attribute named like a parameter or option) raises ``AttributeError``, both naming
+    :meth:`with_params`, which returns a validated copy.
+
+    Examples
+    --------
+    >>> import roughbrdf as rb
+    >>> m = rb.model("lambertian", rho=0.5)
+    >>> m.rho = 0.2
+    Traceback (most recent call last):
+    ...
+    AttributeError: cannot set 'rho' on a lambertian model: ... use m = m.with_params(rho=...) ...
+    >>> m.with_params(rho=0.2).params
+    {'rho': 0.2}
     """
 
     name: ClassVar[str] = ""
@@ -126,25 +147,48 @@ class Model:
     def _pack(self) -> tuple:
         raise NotImplementedError
 
+    # -- immutability ---------------------------------------------------------------------------
+    def _guarded_names(self) -> set[str]:
+        """Names whose assignment would look like changing the model: every parameter and
+        option (for a sum, also the components' plain names), ``params`` and ``options``."""
+        d = self.__dict__
+        names = {p.name for p in type(self).PARAMETERS} | set(type(self).OPTIONS)
+        names |= {p.name for p in d.get("_specs", ())} | set(d.get("_options", ()))
+        for c in d.get("components", ()):
+            names |= c._guarded_names()
+        return names | {"params", "options", "parameters", "param_names"}
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if not name.startswith("_") and name in self._guarded_names():
+            what = name if name not in ("params", "options", "parameters", "param_names") \
+                else "name"
+            raise AttributeError(
+                f"cannot set {name!r} on a {self.name} model: models are immutable values; "
+                f"use m = m.with_params({what}=...) for a validated copy")
+        object.__setattr__(self, name, value)
+
     # -- parameters -----------------------------------------------------------------------------
     @property
-    def params(self) -> dict[str, float | None]:
-        """``{name: value}`` of the numeric parameters."""
-        return dict(self._values)
+    def params(self) -> ReadOnlyDict:
+        """``{name: value}`` of the numeric parameters, read-only (see the class notes; a
+        changed copy of the model is :meth:`with_params`, a changeable dict ``dict(m.params)``).
+        """
+        return ReadOnlyDict(self._values, "model parameters")
 
     def _floats(self) -> dict[str, float]:
         """The parameters that are set (not ``None``), as floats: what ``_pack`` packs."""
         return {k: v for k, v in self._values.items() if v is not None}
 
     @property
-    def options(self) -> dict[str, Any]:
-        """Non-numeric settings (distribution, shadowing, readings)."""
-        return dict(self._options)
+    def options(self) -> ReadOnlyDict:
+        """Non-numeric settings (distribution, shadowing, readings), read-only."""
+        return ReadOnlyDict(self._options, "model options")
 
     @property
-    def parameters(self) -> list[Parameter]:
-        """The parameters as :class:`Parameter` objects (value, bounds, unit, description)."""
-        return [replace(p, value=self._values[p.name]) for p in self._specs]
+    def parameters(self) -> tuple[Parameter, ...]:
+        """The parameters as (frozen) :class:`Parameter` objects (value, bounds, unit,
+        description, domain)."""
+        return tuple(replace(p, value=self._values[p.name]) for p in self._specs)
 
     @property
     def param_names(self) -> list[str]:
@@ -172,13 +216,17 @@ class Model:
                 polarization: Any = None) -> PreparedGeometry:
         """Validate and convert the inputs once, for repeated :meth:`evaluate_prepared` calls.
 
-        Raises ``ValueError`` naming the argument and the offending value for angles outside
-        the hemisphere (or ``theta_i = pi/2`` where the model is not defined there) and for a
-        bad polarization.
+        Raises :class:`~roughbrdf.errors.ArgumentError` (a ``ValueError``) naming the argument
+        and the offending value for angles that are not numbers (``None`` included) or outside
+        the hemisphere (or ``theta_i = pi/2`` where the model is not defined there), for a bad
+        polarization, and naming both arrays and their shapes when they do not broadcast.
         """
         ti, tr, ph = check_angles(theta_i, theta_r, phi,
                                   grazing_incidence=self.grazing_incidence)
-        return PreparedGeometry(ti, tr, ph, Polarization.parse(polarization).gamma)
+        gamma = Polarization.parse(polarization).gamma
+        if gamma.ndim:
+            check_broadcast(theta_i=ti, theta_r=tr, phi=ph, polarization=gamma)
+        return PreparedGeometry(ti, tr, ph, gamma)
 
     def evaluate_prepared(self, geometry: PreparedGeometry, quantity: Quantity | str = "brdf",
                           *, term: str | None = None) -> np.ndarray | float:
@@ -246,7 +294,8 @@ class Model:
         """The compiled evaluation (``flag`` 0: f_r, 1: f_r cos theta_r); models with terms or
         their own drivers override it."""
         if term is not None:
-            raise ValueError(f"model {self.name!r} has no separate terms; got term={term!r}")
+            raise ArgumentError("term", f"model {self.name!r} has no separate terms",
+                                value=term)
         drive = type(self)._drive
         if drive is None:  # pragma: no cover - every registered model has a driver
             raise NotImplementedError(f"model {self.name!r} has no compiled driver")
@@ -292,7 +341,7 @@ class SumModel(Model):
     short = "sum"
 
     def __init__(self, components: Sequence[Model]) -> None:  # noqa: D107
-        self.components = [copy.copy(c) for c in components]
+        self.components = tuple(copy.copy(c) for c in components)
         counts: dict[str, int] = {}
         for c in self.components:
             counts[c.short] = counts.get(c.short, 0) + 1
@@ -327,8 +376,8 @@ class SumModel(Model):
             groups.setdefault(i, ([], []))[0].append(base)
             groups[i][1].append(v)
         new = copy.copy(self)
-        new.components = [c.with_values(*groups[i]) if i in groups else c
-                          for i, c in enumerate(self.components)]
+        new.components = tuple(c.with_values(*groups[i]) if i in groups else c
+                               for i, c in enumerate(self.components))
         new._refresh()
         return new
 
@@ -347,7 +396,7 @@ class SumModel(Model):
             elif term in (c.short, c.name, pre[:-1]):
                 parts.append(c.evaluate_prepared(g, q))
         if not parts:
-            raise ValueError(f"no component of this sum has a term {term!r}")
+            raise ArgumentError("term", "no component of this sum has this term", value=term)
         return sum(parts[1:], parts[0])
 
     def to_dict(self) -> dict[str, Any]:

@@ -8,7 +8,7 @@ from numba import prange
 
 from .._kernels import at, driver, jit, sincos
 from .base import Model, register
-from .parameters import unit_interval
+from .parameters import reflectance
 
 
 @jit(inline=True)
@@ -47,7 +47,7 @@ class Lambertian(Model):
     aliases = ("lambert", "diffuse")
     short = "lambertian"
     reference = "Lambert 1760; TR75 Eq. 32"
-    PARAMETERS = (unit_interval("rho", 0.5, "directional-hemispherical reflectance"),)
+    PARAMETERS = (reflectance("rho", 0.5, "directional-hemispherical reflectance"),)
     grazing_incidence = True
     _drive = _lambert_drive
 

@@ -6,7 +6,8 @@ Cook & Torrance (1982) / Walter et al. (2007) form, built from :mod:`roughbrdf.d
     f_r = ks F(theta_d) D(theta_h) G / (4 cos theta_i cos theta_r)
 
 ``F`` at the local angle ``theta_d`` (polarization per TR75 Eq. 24); ``n=None`` gives ``F = 1``.
-``ks`` is an overall scale (1 for a physical surface; free for fits to data of unknown scale).
+``ks`` is an overall scale (1 for a physical surface; free for fits to data of unknown scale):
+not a reflectance of a part, so it is not limited to [0, 1] (``roughbrdf.models.parameters``).
 The parameter ``alpha`` is the width parameter of the chosen distribution: ``e`` for
 Trowbridge-Reitz/GGX and Berry, ``m`` for Beckmann, ``c`` (per degree) for gaussian-angle, ``A2``
 for Sirohi.

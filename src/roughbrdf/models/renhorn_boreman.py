@@ -59,7 +59,7 @@ from ..fresnel import check_index, fresnel_sp
 from ..interrupts import held_interrupts
 from ..registry import Registry
 from .base import Model, PreparedGeometry, register
-from .parameters import Parameter, nonnegative, positive
+from .parameters import Parameter, nonnegative, positive, reflectance
 
 __all__ = ["RenhornBoreman2008", "rb08_norm", "lobe_integral"]
 
@@ -538,10 +538,13 @@ class RenhornBoreman2008(Model):
         Decay of Vm's incidence weight. *Certain* as a symbol.
     n_eff, k_eff : float
         Effective complex index ``n_eff + i k_eff`` of the Fresnel factor (Eqs. 16-17). *Certain.*
-    bulk, retro : float >= 0
+    bulk, retro : float in [0, 1]
         Strengths of the bulk (Lambertian) and retro terms, ``sigma_bulk = (1 - sigma_s) bulk``,
         ``sigma_retro = (1 - sigma_s) retro`` (Eqs. 19-20). *Certain* as strengths; the bulk
         term's Lambertian shape is *our reading* (the shapes were defined in the lost prose).
+        Both are reflectances of a part (before the Fresnel weight ``1 - sigma_s``), so their
+        domain is ``[0, 1]`` like every reflectance-like parameter
+        (:data:`~roughbrdf.models.parameters.REFLECTANCE_DOMAIN`).
     rho_r, w_r, n_r : float
         Retro lobe width and its own shadowing pair. *Our reading:* ``rho_r`` is probable (a
         retro lobe needs a width), ``w_r``, ``n_r`` speculative (docs/models.md §4.11).
@@ -648,9 +651,9 @@ class RenhornBoreman2008(Model):
         _real("delta", 0.0, (-5.0, 5.0), "1/rad^2", "Vm incidence weight decay, Eq. 13"),
         positive("n_eff", 1.5, (0.2, 5.0), "1", "effective refractive index, Eqs. 16-17"),
         nonnegative("k_eff", 0.0, (0.0, 10.0), "1", "effective extinction index, Eqs. 16-17"),
-        nonnegative("bulk", 0.85, (0.0, 1.0), "1",
+        reflectance("bulk", 0.85,
                     "bulk (Lambertian) strength, sigma_bulk = (1 - sigma_s) bulk, Eq. 19"),
-        nonnegative("retro", 0.02, (0.0, 1.0), "1",
+        reflectance("retro", 0.02,
                     "retro-reflection strength, sigma_retro = (1 - sigma_s) retro, Eq. 20"),
         positive("rho_r", 0.2, (0.005, 2.0), "1", "retro lobe width (our reading)"),
         positive("w_r", 0.9, (0.05, 2.0), "1", "retro shadowing cut-off (our reading)"),

@@ -26,11 +26,12 @@ from numpy.typing import ArrayLike
 
 from .. import distributions as dist
 from .._kernels import at, driver, jit
+from ..errors import ArgumentError
 from ..fresnel import check_index, fresnel_polarized_xy
 from ..geometry import half_vector, tr75_eta_xy
 from ..shadowing import v_groove_g_over_cos_cos, v_groove_g_over_cos_r
 from .base import Model, register
-from .parameters import Parameter, nonnegative, positive
+from .parameters import Parameter, nonnegative, positive, reflectance
 
 
 @jit(inline=True)
@@ -100,7 +101,9 @@ class TorranceSparrow1967(Model):
         Complex index ``n + i k`` of the facet material; ``n=None`` sets ``F = 1``
         (Figs. 8, 10, 11).
     rho_d : float
-        Scale of the absolute form: ``rho_d/pi`` is the diffuse BRDF (sr⁻¹).
+        Scale of the absolute form: ``rho_d/pi`` is the diffuse BRDF (sr⁻¹), so ``rho_d`` is the
+        directional-hemispherical reflectance of the diffuse part, in [0, 1] like every
+        reflectance-like parameter (:data:`~roughbrdf.models.parameters.REFLECTANCE_DOMAIN`).
 
     Notes
     -----
@@ -129,13 +132,15 @@ class TorranceSparrow1967(Model):
                   (0.0, False, math.inf, False), optional=True),
         Parameter("k", None, (0.0, 10.0), "1", "extinction index, n + ik (None: 0)",
                   (0.0, True, math.inf, False), optional=True),
-        positive("rho_d", 0.3, (1e-4, 1.0), "1", "diffuse reflectance scale, rho_d/pi sr^-1"),
+        reflectance("rho_d", 0.3, "reflectance of the diffuse part (its BRDF is rho_d/pi sr^-1)",
+                    bounds=(1e-4, 1.0)),
     )
 
     def _validate(self) -> None:
         n, k = self._values["n"], self._values["k"]
         if n is None and k not in (None, 0.0):
-            raise ValueError(f"parameter 'k' = {k!r} given without 'n' (n=None means F = 1)")
+            raise ArgumentError("k", "parameter 'k' given without 'n' (n=None means F = 1)",
+                                value=k)
         if n is not None:
             check_index(n, 0.0 if k is None else k)
 

@@ -31,7 +31,7 @@ from .._kernels import at, driver, jit
 from ..fresnel import check_index, fresnel_polarized_xy
 from ..geometry import half_vector, tr75_eta_xy
 from .base import Model, register
-from .parameters import nonnegative, positive, unit_interval
+from .parameters import nonnegative, positive, reflectance
 
 
 @jit(inline=True)
@@ -99,7 +99,7 @@ class TrowbridgeReitz1975(Model):
         positive("e", 0.68, (0.02, 3.0), "1", "ellipsoid axis ratio (GGX alpha = e)"),
         positive("n", 1.0, (0.2, 5.0), "1", "refractive index (n + ik)"),
         nonnegative("k", 0.9, (0.0, 10.0), "1", "extinction index (n + ik), >= 0 absorbing"),
-        unit_interval("rho_L", 0.33, "Lambertian directional-hemispherical reflectance"),
+        reflectance("rho_L", 0.33, "Lambertian directional-hemispherical reflectance"),
     )
     OPTIONS = {"shadowing": "none"}
     _drive = _tr75_drive

@@ -25,7 +25,7 @@ import inspect
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
-from ._common import Reproduction, Table, Unavailable, check_writable
+from ._common import Reproduction, Table, Unavailable
 
 __all__ = ["PAPERS", "Reproduction", "Table", "Unavailable", "reproductions", "run"]
 
@@ -33,10 +33,15 @@ __all__ = ["PAPERS", "Reproduction", "Table", "Unavailable", "reproductions", "r
 PAPERS = {"ts67": "ts67", "tr75": "tr75", "rb08": "rb08"}
 
 
-def _functions(paper: str) -> tuple[Callable[[], Reproduction], ...]:
+def _paper_key(paper: str, *, every: bool = False) -> str:
     key = paper.strip().lower()
-    if key not in PAPERS:
+    if key not in PAPERS and not (every and key == "all"):
         raise ValueError(f"unknown paper {paper!r}; choose from {', '.join(PAPERS)} or 'all'")
+    return key
+
+
+def _functions(paper: str) -> tuple[Callable[[], Reproduction], ...]:
+    key = _paper_key(paper)
     mod = importlib.import_module(f"{__name__}.{PAPERS[key]}")
     return tuple(mod.ALL)
 
@@ -70,27 +75,39 @@ def reproductions(paper: str = "all", *, data_dir: str | Path | None = None,
             yield rep
 
 
-def run(paper: str, out: str | Path, *, force: bool = False, compact: bool = False,
+def run(paper: str, out: str | Path, *, overwrite: bool = False, compact: bool = False,
         data_dir: str | Path | None = None,
         echo: Callable[[str], None] | None = None) -> list[Path]:
     """Write the reproductions of ``paper`` (or ``"all"``) into ``out``; return the paths.
 
-    Existing files are never overwritten unless ``force``; the check is done per reproduction
-    before anything of it is written. ``compact`` writes palette PNGs (smaller, for committing);
-    ``data_dir`` is passed to :func:`reproductions`.
+    ``out`` receives them as one set (:class:`roughbrdf.output.ResultFolder`): a folder that
+    holds results already (or any file of the same names) is refused before anything is
+    computed, unless ``overwrite`` (the CLI's ``--force``), which replaces exactly the earlier
+    run's files; files roughbrdf did not write are never replaced. The files are committed
+    together at the end: an error or Ctrl-C leaves the folder as it was. ``compact`` writes
+    palette PNGs (smaller, for committing); ``data_dir`` is passed to :func:`reproductions`.
     """
-    out = Path(out)
-    written: list[Path] = []
-    for rep in reproductions(paper, data_dir=data_dir, echo=echo):
-        check_writable(rep.outputs(out), force)
-        paths = rep.write(out, force=force, compact=compact)
-        if rep.figure is not None:
-            rep.figure.clear()
-        written.extend(paths)
-        if echo is not None:
-            echo(f"{rep.name}: {rep.title}")
-            for note in rep.notes:
-                echo(f"    note: {note}")
-            for p in paths:
-                echo(f"    wrote {p}")
-    return written
+    from ..output import ResultFolder
+
+    _paper_key(paper, every=True)
+    folder = ResultFolder(out, overwrite=overwrite)
+    folder.check([])
+    staged: list[str] = []
+    with folder:
+        for rep in reproductions(paper, data_dir=data_dir, echo=echo):
+            files = rep.files(compact=compact)
+            folder.check(list(files))
+            for name, content in files.items():
+                folder.add(name, content, binary=callable(content))
+            if rep.figure is not None:
+                rep.figure.clear()
+            staged.extend(files)
+            if echo is not None:
+                echo(f"{rep.name}: {rep.title}")
+                for note in rep.notes:
+                    echo(f"    note: {note}")
+    paths = [folder.path / name for name in staged]
+    if echo is not None:
+        for p in paths:
+            echo(f"    wrote {p}")
+    return paths

@@ -1,13 +1,17 @@
-"""The result of one reproduction (figure + the numbers behind it) and how it is written."""
+"""The result of one reproduction (figure + the numbers behind it) and how it is written.
+
+Files are written atomically and never replace a file unless asked (``overwrite=True``; the
+CLI's ``--force``): :mod:`roughbrdf.output`.
+"""
 
 from __future__ import annotations
 
 import csv
 import io
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -102,29 +106,45 @@ class Reproduction:
             paths.append(out / f"{self.name}.md")
         return paths
 
-    def write(self, out: Path, *, force: bool = False, dpi: int = DPI,
-              compact: bool = False) -> list[Path]:
-        """Write the PNG, CSV(s) and Markdown into ``out``; refuse to overwrite unless ``force``.
-
-        ``compact`` stores the PNG with a 256-colour palette (about a third of the size; used
-        for the images committed under ``docs/img``).
-        """
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        paths = self.outputs(out)
-        check_writable(paths, force)
-        it = iter(paths)
+    def files(self, *, dpi: int = DPI, compact: bool = False
+              ) -> dict[str, str | Callable[[IO[bytes]], None]]:
+        """The files of :meth:`outputs` by name: text, or a writer of the PNG bytes."""
+        names = [p.name for p in self.outputs(Path("."))]
+        it = iter(names)
+        out: dict[str, str | Callable[[IO[bytes]], None]] = {}
         if self.figure is not None:
-            save_png(self.figure, next(it), dpi=dpi, compact=compact)
+            fig = self.figure
+            out[next(it)] = lambda fh: save_png(fig, fh, dpi=dpi, compact=compact)
         for table in self.tables.values():
-            next(it).write_text(table.to_csv())
+            out[next(it)] = table.to_csv()
         if self.markdown is not None:
-            next(it).write_text(self.markdown)
+            out[next(it)] = self.markdown
+        return out
+
+    def write(self, out: Path, *, overwrite: bool = False, dpi: int = DPI,
+              compact: bool = False) -> list[Path]:
+        """Write the PNG, CSV(s) and Markdown into ``out``; refuse to replace a file unless
+        ``overwrite``.
+
+        Every file is written atomically (:func:`roughbrdf.output.atomic_write`) after all of
+        them were checked. ``compact`` stores the PNG with a 256-colour palette (about a third
+        of the size; used for the images committed under ``docs/img``).
+        """
+        from ..output import atomic_write, ensure_folder
+
+        out = ensure_folder(out)
+        paths = self.outputs(out)
+        check_writable(paths, overwrite)
+        for path, content in zip(paths, self.files(dpi=dpi, compact=compact).values(),
+                                 strict=True):
+            atomic_write(path, content, overwrite=overwrite, binary=callable(content))
         return paths
 
 
-def save_png(fig: Figure, path: Path, *, dpi: int = DPI, compact: bool = False) -> None:
-    """Save ``fig`` as PNG; ``compact`` quantizes to a 256-colour palette (Pillow)."""
+def save_png(fig: Figure, path: Path | IO[bytes], *, dpi: int = DPI,
+             compact: bool = False) -> None:
+    """Save ``fig`` as PNG to a path or an open binary file; ``compact`` quantizes to a
+    256-colour palette (Pillow)."""
     if not compact:
         fig.savefig(path, dpi=dpi, format="png")
         return
@@ -138,13 +158,16 @@ def save_png(fig: Figure, path: Path, *, dpi: int = DPI, compact: bool = False) 
             path, format="PNG", optimize=True)
 
 
-def check_writable(paths: Sequence[Path], force: bool) -> None:
-    """Raise ``FileExistsError`` naming the first existing file unless ``force``."""
-    if force:
+def check_writable(paths: Sequence[Path], overwrite: bool) -> None:
+    """Raise :class:`roughbrdf.output.OverwriteRefused` naming the first existing file unless
+    ``overwrite``."""
+    from ..output import OverwriteRefused
+
+    if overwrite:
         return
     for p in paths:
         if Path(p).exists():
-            raise FileExistsError(f"{p} exists; use --force (force=True) to overwrite")
+            raise OverwriteRefused(p, single=True)
 
 
 def new_figure(nrows: int = 1, ncols: int = 1, *, figsize: tuple[float, float] = (6.4, 4.8),

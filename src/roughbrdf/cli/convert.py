@@ -122,11 +122,10 @@ def _report(m: Any, dst: Path, fout: str, result: Any) -> None:
 
 def _convert(src: Path, dst: Path, args: dict[str, Any]) -> None:
     from .. import io as _io
-    from ..measurement import QUANTITIES
+    from ..quantity import Quantity
 
-    quantity = args["quantity"]
-    if quantity is not None and quantity not in QUANTITIES:
-        raise ValueError(f"--quantity must be one of {', '.join(QUANTITIES)}, got {quantity!r}")
+    if args["quantity"] is not None:  # the same spellings as every other verb's --quantity
+        args = {**args, "quantity": Quantity.parse(args["quantity"], "--quantity").value}
     _check_paths(src, dst, args["force"])
     fin = _io.format_for(src, args["from_"])
     fout = _io.format_for(dst, args["to"])

@@ -644,9 +644,10 @@ def test_error_bad_options():
     meas = ts67_absolute(seed=0)
     with pytest.raises(ValueError, match="unknown loss 'squared'; choose one of relative, log"):
         rb.fit("ts67", meas, loss="squared")
-    with pytest.raises(ValueError, match="nonfinite must be"):
+    # worded as argument errors (roughbrdf.errors): the CLI shows them as --nonfinite/--negative
+    with pytest.raises(ValueError, match="nonfinite = 'ignore': must be 'raise' or 'drop'"):
         rb.fit("ts67", meas, nonfinite="ignore")
-    with pytest.raises(ValueError, match="negative must be"):
+    with pytest.raises(ValueError, match="negative = 'abs': must be 'keep', 'drop' or 'clip'"):
         rb.fit("ts67", meas, negative="abs")
     with pytest.raises(ValueError, match="unknown parameter .*'gg'"):
         rb.fit("ts67", meas, fix=["gg"])

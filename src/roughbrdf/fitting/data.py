@@ -130,11 +130,10 @@ class DataOptions:
             raise ArgumentError("loss", f"unknown loss {self.loss!r}; choose one of "
                                 f"{', '.join(LOSSES)}")
         if not isinstance(self.nonfinite, str) or self.nonfinite not in ("raise", "drop"):
-            raise ArgumentError("nonfinite", f"nonfinite must be 'raise' or 'drop', got "
-                                f"{self.nonfinite!r}")
+            raise ArgumentError("nonfinite", "must be 'raise' or 'drop'", value=self.nonfinite)
         if not isinstance(self.negative, str) or self.negative not in ("keep", "drop", "clip"):
-            raise ArgumentError("negative", f"negative must be 'keep', 'drop' or 'clip', got "
-                                f"{self.negative!r}")
+            raise ArgumentError("negative", "must be 'keep', 'drop' or 'clip'",
+                                value=self.negative)
 
 
 # --------------------------------------------------------------------------------------------

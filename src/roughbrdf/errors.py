@@ -17,6 +17,9 @@ Examples
 'aperture = 2.0 rad: must be below 90 deg'
 >>> err.render({"aperture": "--aperture"})
 '--aperture 114.6 (degrees): must be below 90 deg'
+>>> import pickle
+>>> str(pickle.loads(pickle.dumps(err))) == str(err)
+True
 """
 
 from __future__ import annotations
@@ -27,7 +30,11 @@ from typing import Any
 
 __all__ = ["ArgumentError"]
 
-_UNSET = object()
+class _Unset:
+    """Marker of an argument not given (a class: it pickles by reference, keeping identity)."""
+
+
+_UNSET: Any = _Unset
 
 
 class ArgumentError(ValueError):
@@ -56,6 +63,11 @@ class ArgumentError(ValueError):
         self.unit = unit
         super().__init__(self.render())
 
+    def __reduce__(self) -> tuple[Any, ...]:
+        # picklable (errors cross process boundaries, e.g. from worker processes): rebuild
+        # from the same fields
+        return (_rebuild, (self.argument, self.message, self.value, self.fix, self.unit))
+
     def render(self, options: Mapping[str, str] | None = None) -> str:
         """The message naming the argument as ``options[argument]`` (a CLI option, shown in
         CLI style with degrees) or, without ``options``, as the Python argument."""
@@ -70,6 +82,16 @@ class ArgumentError(ValueError):
         if self.fix is not _UNSET:
             text += f"; pass {name} {self.fix}" if cli else f"; pass {name}={self.fix!r}"
         return text
+
+
+def _rebuild(argument: str, message: str, value: Any, fix: Any, unit: str | None
+             ) -> ArgumentError:
+    kw: dict[str, Any] = {"unit": unit}
+    if value is not _UNSET:
+        kw["value"] = value
+    if fix is not _UNSET:
+        kw["fix"] = fix
+    return ArgumentError(argument, message, **kw)
 
 
 def _cli_value(value: Any, unit: str | None) -> str:

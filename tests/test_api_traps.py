@@ -328,6 +328,8 @@ BAD_OPTIONS = {
                         st.just({"rho": (0.5, 0.1)}), st.just({"rho": (-1, 0.5)})),
     "fix": st.one_of(st.just(["e"]), st.just(5), st.just(["rho"])),
     "scale": st.one_of(JUNK, st.just(0.0), st.just(-2.0), st.just(math.inf)),
+    "theta_r_max": st.one_of(JUNK, st.just(-0.1), st.just(HALF_PI + 0.01), st.just(True)),
+    "source_exclusion": st.one_of(JUNK, st.just(-0.1), st.just(4.0), st.just(math.inf)),
 }
 
 

@@ -10,7 +10,10 @@ before the fit (``--force`` replaces an earlier run's results, never a file roug
 write). ``--aperture DEG`` compares each sample with the model averaged over a uniform cone of
 that half-angle (degrees) about the measured reflection direction (``rb.fit(...,
 aperture=radians)``). ``--free-scale`` fits a closed-form scale ``K`` of the data also for
-absolute data (``rb.fit(..., free_scale=True)``), ``--no-plots`` skips the figures (and
+absolute data (``rb.fit(..., free_scale=True)``), ``--theta-r-max DEG`` and
+``--source-exclusion DEG`` leave out (and count) the samples beyond that reflection angle or
+within that angle of the direction toward the source (``rb.fit(..., theta_r_max=,
+source_exclusion=)`` in radians), ``--no-plots`` skips the figures (and
 Matplotlib). ``--bounds NAME=LOW:HIGH`` overrides a parameter's search range; ``--angles-in``
 states the angle unit of an ASTM or CSV file that does not.
 
@@ -38,6 +41,7 @@ OPTIONS = {"model": "--model", "fix": "--fix", "bounds": "--bounds", "channel": 
            "relative_to": "--relative-to", "format": "--format", "angles": "--angles-in",
            "nonfinite": "--nonfinite", "negative": "--negative", "seed": "--seed",
            "free_scale": "--free-scale", "aperture": "--aperture", "out_dir": "--out",
+           "theta_r_max": "--theta-r-max", "source_exclusion": "--source-exclusion",
            "overwrite": "--force", "plots": "--plots/--no-plots"}
 
 #: spellings of --angles-in -> the readers' angles= option
@@ -172,6 +176,7 @@ def run_fit(file: str, model: str, out: str, *, param: list[str] | None,
             fix: list[str] | None, bounds: list[str] | None, channel: list[str] | None,
             angles_in: str | None, quantity: str | None, file_format: str | None,
             aperture: float | None, plots: bool, force: bool, quiet: bool,
+            theta_r_max: float | None = None, source_exclusion: float | None = None,
             **fit_options: Any) -> int:
     """The work of ``roughbrdf fit``; returns the exit status (0, or 1 if not converged).
 
@@ -179,9 +184,13 @@ def run_fit(file: str, model: str, out: str, *, param: list[str] | None,
     and that ``out`` may receive the results (:meth:`roughbrdf.output.ResultFolder.check`).
     """
     from ..fitting import fit
+    from ..fitting.data import check_fit_domain
     from ..output import ResultFolder
 
     ap = check_aperture(aperture)
+    # degrees -> radians; checked by the library (errors name the option, in degrees)
+    t_max, excl = check_fit_domain(*(None if v is None else math.radians(v)
+                                     for v in (theta_r_max, source_exclusion)))
     given = parse_params(param)
     m = build_model(model, given)
     fixed = resolve_names(m, list(fix or []))
@@ -193,7 +202,8 @@ def run_fit(file: str, model: str, out: str, *, param: list[str] | None,
     # labels or positions as text; Measurement.channel_index resolves both ("525" also finds
     # "525nm")
     res = fit(m, meas, channel=chans, fix=fixed, bounds=ranges or None, aperture=ap,
-              progress=None if not quiet else False, **fit_options)
+              theta_r_max=t_max, source_exclusion=excl, progress=None if not quiet else False,
+              **fit_options)
     written = res.save(out, plots=plots, overwrite=force)
     if not quiet:
         typer.echo(res.report())
@@ -245,6 +255,13 @@ def register(app: typer.Typer) -> None:
                                        help="instrument aperture: half-angle in degrees of a "
                                             "uniform cone about the reflection direction; the "
                                             "model is averaged over it (default: none)"),
+        theta_r_max: float = typer.Option(None, "--theta-r-max", metavar="DEG",
+                                          help="fit domain: leave out samples with theta_r "
+                                               "above DEG (counted; default: none)"),
+        source_exclusion: float = typer.Option(None, "--source-exclusion", metavar="DEG",
+                                               help="fit domain: leave out samples within DEG "
+                                                    "of the direction toward the source "
+                                                    "(retro-blocked; counted; default: none)"),
         plots: bool = typer.Option(True, "--plots/--no-plots", help="write PNG plots"),
         force: bool = typer.Option(False, "--force",
                                    help="replace the results of an earlier run in --out (files "
@@ -255,7 +272,9 @@ def register(app: typer.Typer) -> None:
         with handled(OPTIONS):
             code = run_fit(file, model, out, param=param, fix=fix, bounds=bounds,
                            channel=channel, angles_in=angles_in, quantity=quantity,
-                           file_format=file_format, aperture=aperture, plots=plots,
+                           file_format=file_format, aperture=aperture,
+                           theta_r_max=theta_r_max, source_exclusion=source_exclusion,
+                           plots=plots,
                            force=force, quiet=quiet, loss=loss, starts=starts, seed=seed,
                            free_scale=free_scale, nonfinite=nonfinite, negative=negative,
                            relative_to=relative_to)

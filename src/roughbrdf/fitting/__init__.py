@@ -69,7 +69,8 @@ def fit(model: Model | str, measurement: Measurement, *,
         scale: float | None = None,
         screen: int = 64, subsample: int | None = 1000, polish: int = 2,
         max_nfev: int | None = None, aperture: float | None = None,
-        aperture_points: int = 19,
+        aperture_points: int = 19, theta_r_max: float | None = None,
+        source_exclusion: float | None = None,
         progress: bool | None = None) -> FitResult:
     """Fit ``model`` to ``measurement``, each channel on its own.
 
@@ -134,6 +135,14 @@ def fit(model: Model | str, measurement: Measurement, *,
     aperture_points : {7, 19, 37}
         Size of the cubature rule over the cone (:func:`~roughbrdf.instrument.aperture_stencil`);
         the fit costs about that many times more model evaluations.
+    theta_r_max : float or None
+        Fit domain: leave out the samples with ``theta_r > theta_r_max`` (radians,
+        ``0 <= theta_r_max <= pi/2``; counted in ``excluded``). None: no limit.
+    source_exclusion : float or None
+        Fit domain: leave out the samples whose reflection direction is less than this angle
+        (radians, ``0 <= source_exclusion <= pi``) from the direction toward the source (the
+        retro direction ``theta_r = theta_i, phi = pi``), e.g. where the source blocks the
+        detector; counted in ``excluded``. None: no exclusion.
     progress : bool or None
         Show a tqdm progress bar; ``None`` shows it only on an interactive terminal.
 
@@ -146,7 +155,8 @@ def fit(model: Model | str, measurement: Measurement, *,
     ValueError
         Unknown loss or option, every parameter fixed, no data left in a channel, non-finite
         values with ``nonfinite="raise"``, non-positive values for the log loss with
-        ``negative="keep"``, an aperture that is negative, not finite or >= pi/2, bounds that
+        ``negative="keep"``, an aperture that is negative, not finite or >= pi/2, a
+        ``theta_r_max`` or ``source_exclusion`` outside [0, pi/2] or [0, pi], bounds that
         do not contain the starting value or leave a parameter's physical domain. Errors
         about an argument are :class:`~roughbrdf.errors.ArgumentError` (naming the argument,
         the value and, where there is one, the fix; ``err.render(options)`` words them for
@@ -157,7 +167,7 @@ def fit(model: Model | str, measurement: Measurement, *,
     chans = channel_indices(measurement, channel)
     ap = Aperture.parse(aperture, aperture_points)
     opts = DataOptions(Comparison.of(measurement, relative_to), loss, weights, nonfinite,
-                       negative, ap)
+                       negative, ap, theta_r_max, source_exclusion)
     search = SearchOptions(starts, screen, subsample, polish, max_nfev, seed)
     k_free, k_fixed = data_scale(measurement, free_scale, scale)
     params = FreeParameters.of(model, fix, bounds)
@@ -181,6 +191,7 @@ def fit(model: Model | str, measurement: Measurement, *,
                "free_scale": k_free, "scale": scale,
                "aperture": None if ap is None else ap.half_angle,
                "aperture_points": None if ap is None else ap.points,
+               "theta_r_max": opts.theta_r_max, "source_exclusion": opts.source_exclusion,
                "fix": sorted(set(model.param_names) - set(params.names)),
                "weights": None if weights is None else
                (weights if isinstance(weights, str) else "array")}

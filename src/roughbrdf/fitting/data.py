@@ -8,9 +8,11 @@
 * :func:`prepare_channel` -- the samples of one channel that enter the fit, as a
   :class:`ChannelData`. Samples are never dropped silently: non-finite values raise or are
   dropped (``nonfinite``), negative ones are kept, dropped or clipped (``negative``), samples of
-  weight 0, where the model is not finite or not defined, and (BRDF cos data with the relative or
-  log loss) at ``theta_r = 90`` deg are left out, and every count is kept in
-  :attr:`ChannelData.excluded` (:data:`EXCLUSION_REASONS`);
+  weight 0, outside the fit domain the user chose (``theta_r_max``, ``source_exclusion``:
+  :func:`outside_fit_domain`), where the model is not finite or not defined, and (BRDF cos data
+  with the relative or log loss) at ``theta_r = 90`` deg are left out, and every count is kept
+  in :attr:`ChannelData.excluded` (:data:`EXCLUSION_REASONS`; a sample is counted under the
+  first reason that applies);
 * :func:`channel_weights` -- the residual weights (an array, or ``"uncertainty"``).
 """
 
@@ -32,7 +34,7 @@ if TYPE_CHECKING:
     from ..models import Model
 
 __all__ = ["Comparison", "ChannelData", "DataOptions", "EXCLUSION_REASONS", "channel_weights",
-           "excluded_text", "prepare_channel", "where"]
+           "check_fit_domain", "excluded_text", "outside_fit_domain", "prepare_channel", "where"]
 
 #: the reasons a sample is left out or changed, in the order reports list them
 EXCLUSION_REASONS: dict[str, str] = {
@@ -40,6 +42,8 @@ EXCLUSION_REASONS: dict[str, str] = {
     "negative": "negative (dropped)",
     "clipped": "negative (clipped)",
     "zero_weight": "of zero weight",
+    "theta_r_max": "with theta_r above theta_r_max",
+    "source_exclusion": "within the source exclusion (angle to the source direction)",
     "model_domain": "where the model is not finite or not defined",
     "horizon": "at theta_r = 90 deg (BRDF cos theta_r = 0 for every model)",
 }
@@ -124,8 +128,13 @@ class DataOptions:
     nonfinite: str = "raise"
     negative: str = "keep"
     aperture: Aperture | None = None
+    theta_r_max: float | None = None
+    source_exclusion: float | None = None
 
     def __post_init__(self) -> None:
+        t_max, excl = check_fit_domain(self.theta_r_max, self.source_exclusion)
+        object.__setattr__(self, "theta_r_max", t_max)
+        object.__setattr__(self, "source_exclusion", excl)
         if not isinstance(self.loss, str) or self.loss not in LOSSES:
             raise ArgumentError("loss", f"unknown loss {self.loss!r}; choose one of "
                                 f"{', '.join(LOSSES)}")
@@ -134,6 +143,74 @@ class DataOptions:
         if not isinstance(self.negative, str) or self.negative not in ("keep", "drop", "clip"):
             raise ArgumentError("negative", "must be 'keep', 'drop' or 'clip'",
                                 value=self.negative)
+
+
+def _domain_angle(argument: str, value: Any, high: float, need: str) -> float | None:
+    """``value`` as a float in ``[0, high]`` (radians), or None; else an ArgumentError."""
+    if value is None:
+        return None
+    if isinstance(value, str | bytes | bool | complex):
+        raise ArgumentError(argument, need, value=value)
+    try:
+        a = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise ArgumentError(argument, need, value=value) from None
+    if not (math.isfinite(a) and 0.0 <= a <= high):
+        raise ArgumentError(argument, need, value=a, unit="rad")
+    return a
+
+
+def check_fit_domain(theta_r_max: Any, source_exclusion: Any
+                     ) -> tuple[float | None, float | None]:
+    """The fit-domain options as floats (radians; None: not used).
+
+    Raises :class:`~roughbrdf.errors.ArgumentError` (``unit="rad"``: the CLI shows degrees)
+    unless ``0 <= theta_r_max <= pi/2`` and ``0 <= source_exclusion <= pi``.
+
+    Examples
+    --------
+    >>> check_fit_domain(None, 0.1)
+    (None, 0.1)
+    >>> try:
+    ...     check_fit_domain(2.0, None)
+    ... except ValueError as err:
+    ...     print(err)
+    theta_r_max = 2.0 rad: must be an angle in [0, 90] deg (None: no limit)
+    """
+    return (_domain_angle("theta_r_max", theta_r_max, 0.5 * math.pi,
+                          "must be an angle in [0, 90] deg (None: no limit)"),
+            _domain_angle("source_exclusion", source_exclusion, math.pi,
+                          "must be an angle in [0, 180] deg (None: no exclusion)"))
+
+
+def outside_fit_domain(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
+                       theta_r_max: float | None = None, source_exclusion: float | None = None
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """Masks ``(above, near_source)`` of the samples outside the fit domain.
+
+    ``above``: ``theta_r > theta_r_max``; ``near_source``: the reflection direction ``w_r`` is
+    less than ``source_exclusion`` from the direction toward the source ``w_i`` (the retro
+    direction ``theta_r = theta_i, phi = pi``), the angle between the unit vectors taken as
+    ``2 asin(|w_r - w_i| / 2)`` (accurate near 0). None: no sample. The nominal (measured)
+    directions are used, also with an aperture.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> above, near = outside_fit_domain([0.5, 0.5], [1.2, 0.52], [0.0, np.pi], 1.0, 0.05)
+    >>> above.tolist(), near.tolist()
+    ([True, False], [False, True])
+    """
+    from ..geometry import unit_vectors
+
+    wi, wr = unit_vectors(theta_i, theta_r, phi)
+    tr = np.broadcast_to(np.asarray(theta_r, dtype=float), wi.shape[:-1])
+    above = (tr > theta_r_max if theta_r_max is not None
+             else np.zeros(tr.shape, dtype=bool))
+    if source_exclusion is None:
+        return above, np.zeros(tr.shape, dtype=bool)
+    dist = 2.0 * np.arcsin(np.clip(0.5 * np.linalg.norm(wr - wi, axis=-1), 0.0, 1.0))
+    return above, dist < source_exclusion
 
 
 # --------------------------------------------------------------------------------------------
@@ -277,6 +354,19 @@ def _bad_values(x: np.ndarray, keep: np.ndarray, excluded: dict[str, int],
         excluded["clipped"] = int(neg.sum())
 
 
+def _fit_domain(meas: Measurement, keep: np.ndarray, excluded: dict[str, int],
+                opts: DataOptions) -> None:
+    """Leave out (in ``keep``) the samples outside the fit domain the user chose."""
+    if opts.theta_r_max is None and opts.source_exclusion is None:
+        return
+    above, near = outside_fit_domain(meas.theta_i, meas.theta_r, meas.phi, opts.theta_r_max,
+                                     opts.source_exclusion)
+    for key, mask in (("theta_r_max", above), ("source_exclusion", near)):
+        out = keep & mask
+        excluded[key] = int(out.sum())
+        keep &= ~out
+
+
 def _outside_domain(model: Model, meas: Measurement, keep: np.ndarray,
                     excluded: dict[str, int], opts: DataOptions) -> None:
     """Leave out (in ``keep``) the samples the model cannot be compared with."""
@@ -328,6 +418,7 @@ def prepare_channel(model: Model, meas: Measurement, j: int, opts: DataOptions) 
     if w is not None:
         excluded["zero_weight"] = int((keep & (w == 0)).sum())
         keep &= w > 0
+    _fit_domain(meas, keep, excluded, opts)
     _outside_domain(model, meas, keep, excluded, opts)
     idx = np.flatnonzero(keep)
     if idx.size == 0:

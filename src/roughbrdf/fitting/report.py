@@ -66,8 +66,17 @@ def _header(result: FitResult) -> list[str]:
             f"    loss               = {_LOSS_TEXT[result.loss]}",
             "    aperture           = " + (
                 "none (model at each measured direction)" if ap is None else ap.describe()),
+            f"    fit domain         = {_domain_text(result.options)}",
             f"    channels           = {len(result.channels)}",
             f"    time               = {result.elapsed:.3g} s"]
+
+
+def _domain_text(options: dict) -> str:
+    """The fit-domain options in words (``"all samples"`` when none)."""
+    t_max, excl = options.get("theta_r_max"), options.get("source_exclusion")
+    parts = ([] if t_max is None else [f"theta_r <= {math.degrees(t_max):.4g} deg"]) + (
+        [] if excl is None else [f">= {math.degrees(excl):.4g} deg from the source direction"])
+    return ", ".join(parts) or "all samples"
 
 
 def _starts_text(c: ChannelFit) -> str:

@@ -166,8 +166,8 @@ def data_scale(meas: Measurement, free_scale: bool | None, scale: float | None
     """``(free_scale, fixed_scale)``: a known ``scale`` is fixed; otherwise ``K`` is free for
     relative data unless ``free_scale`` says otherwise."""
     if scale is not None:
-        try:
-            fixed = float(scale)
+        try:  # a number, not text that reads as one ("1") nor a bool
+            fixed = math.nan if isinstance(scale, str | bytes | bool) else float(scale)
         except (TypeError, ValueError, OverflowError):
             fixed = math.nan
         if not (math.isfinite(fixed) and fixed > 0):

@@ -133,17 +133,6 @@ def recovered_table(res: rb.FitResult) -> str:
 TABLE_FILES = ("ts67_fig8.txt", "tr75_table1_dhr.txt", "recovered.txt")
 
 
-def fit_files(res: rb.FitResult, dpi: int = 110) -> dict[str, Any]:
-    """``fit.json``, ``report.txt`` and the plots of ``res``, as :meth:`rb.FitResult.save`
-    writes them, for a :class:`~roughbrdf.output.ResultFolder` shared with the tables."""
-    files: dict[str, Any] = {"fit.json": res.to_json() + "\n", "report.txt": res.report() + "\n"}
-    for i, name in enumerate(res.plot_names()):
-        fig, _ = res.plot(i)
-        files[name] = (lambda fh, fig=fig: fig.savefig(fh, format="png", dpi=dpi,
-                                                       metadata={"Software": "roughbrdf"}))
-    return files
-
-
 def main(argv: list[str] | None = None) -> int:
     """Run the demo; returns the exit status (0, or 1 if the fit did not converge)."""
     ap = argparse.ArgumentParser(prog="python -m roughbrdf.demo",
@@ -172,7 +161,7 @@ def main(argv: list[str] | None = None) -> int:
     with out:
         for name, text in zip(TABLE_FILES, (t1, t2, t3), strict=True):
             out.add(name, text + "\n")
-        for name, content in fit_files(res).items():
+        for name, content in res.files().items():
             out.add(name, content, binary=callable(content))
     print(f"\nwrote {', '.join(sorted(out.previous()))} into {out.path}/")
     return 0 if res.success else 1

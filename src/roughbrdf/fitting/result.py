@@ -430,22 +430,31 @@ class FitResult:
         """
         from ..output import ResultFolder
 
-        names = ["fit.json", "report.txt", *(self.plot_names() if plots else [])]
+        files = self.files(plots=plots, dpi=dpi)
         with ResultFolder(out_dir, overwrite=overwrite) as out:
-            out.check(names)  # refuse before the (slow) drawing
-            out.add("fit.json", self.to_json() + "\n")
-            text = self.report()
-            out.add("report.txt", text if text.endswith("\n") else text + "\n")
-            if plots:
-                for i, name in enumerate(self.plot_names()):
-                    fig, _ = self.plot(i)
-                    out.add(name, _png_writer(fig, dpi), binary=True)
-        return [out.path / n for n in names]
+            out.check(list(files))  # refuse before the (slow) drawing
+            for name, content in files.items():
+                out.add(name, content, binary=callable(content))
+        return [out.path / n for n in files]
+
+    def files(self, *, plots: bool = True, dpi: int = 110) -> dict[str, Any]:
+        """The set :meth:`save` writes, for a :class:`~roughbrdf.output.ResultFolder`:
+        ``{"fit.json": text, "report.txt": text, "fit_<channel>.png": writer}``; each PNG
+        writer draws its figure only when it is written."""
+        text = self.report()
+        files: dict[str, Any] = {"fit.json": self.to_json() + "\n",
+                                 "report.txt": text if text.endswith("\n") else text + "\n"}
+        if plots:
+            for i, name in enumerate(self.plot_names()):
+                files[name] = _png_writer(self, i, dpi)
+        return files
 
 
-def _png_writer(fig: Any, dpi: int) -> Callable[[IO[bytes]], None]:
-    """A function drawing ``fig`` as PNG into the open (staged) file it is given."""
+def _png_writer(result: FitResult, channel: int, dpi: int) -> Callable[[IO[bytes]], None]:
+    """A function drawing ``result``'s figure of ``channel`` as PNG into the open (staged)
+    file it is given."""
     def write(fh: IO[bytes]) -> None:
+        fig, _ = result.plot(channel)
         fig.savefig(fh, format="png", dpi=dpi, metadata={"Software": "roughbrdf"})
     return write
 

@@ -6,11 +6,18 @@ through :func:`evaluate`. Submodules: :mod:`.compile` (``jit``, ``ufunc``, ``dri
 a model's driver), :mod:`.vmath` (``sincos`` and the other vectorizable elementary functions).
 """
 
-from .broadcast import as_float_array, broadcast_dense, broadcast_strided, evaluate
+from .broadcast import (
+                        as_float_array,
+                        broadcast_array,
+                        broadcast_dense,
+                        broadcast_strided,
+                        evaluate,
+                        run_driver,
+)
 from .cache import locator_installed
 from .compile import DISABLE_JIT, at, driver, jit, ufunc
 from .vmath import SINCOS_MAX_ARG, TINY, sincos
 
-__all__ = ["DISABLE_JIT", "SINCOS_MAX_ARG", "TINY", "as_float_array", "at", "broadcast_dense",
-           "broadcast_strided", "driver", "evaluate", "jit", "locator_installed", "sincos",
-           "ufunc"]
+__all__ = ["DISABLE_JIT", "SINCOS_MAX_ARG", "TINY", "as_float_array", "at", "broadcast_array",
+           "broadcast_dense", "broadcast_strided", "driver", "evaluate", "jit",
+           "locator_installed", "run_driver", "sincos", "ufunc"]

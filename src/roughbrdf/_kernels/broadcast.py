@@ -16,7 +16,8 @@ import numpy as np
 
 from ..interrupts import held_interrupts
 
-__all__ = ["as_float_array", "broadcast_array", "broadcast_dense", "broadcast_strided", "evaluate"]
+__all__ = ["as_float_array", "broadcast_array", "broadcast_dense", "broadcast_strided", "evaluate",
+           "run_driver"]
 
 
 def as_float_array(x: Any, name: str) -> np.ndarray:
@@ -54,6 +55,23 @@ def broadcast_strided(arr: np.ndarray, shape: tuple[int, ...]) -> tuple[np.ndarr
     return np.ascontiguousarray(np.broadcast_to(arr, shape)).reshape(-1), 1
 
 
+#: (driver, which arguments are floats) of the calls that have loaded their compiled variant
+_LOADED: set[tuple[Any, tuple[bool, ...]]] = set()
+
+
+def run_driver(drive: Callable, *args: Any) -> None:
+    """Call a compiled driver; the first call of each variant (the float/array layout of its
+    arguments) runs with Ctrl-C held, since loading or compiling it would swallow the interrupt
+    (:mod:`roughbrdf.interrupts`). Later calls skip the hold (it costs ~7 us a call)."""
+    key = (drive, tuple(type(a) is float for a in args))
+    if key in _LOADED:
+        drive(*args)
+        return
+    with held_interrupts():
+        drive(*args)
+    _LOADED.add(key)
+
+
 def evaluate(
     drive: Callable,
     theta_i: np.ndarray,
@@ -83,8 +101,7 @@ def evaluate(
         args = (broadcast_array(theta_i, shape), broadcast_array(theta_r, shape),
                 broadcast_array(phi, shape), broadcast_dense(gamma, shape), p, int(flag),
                 out if out_shape else out.reshape(n))
-        with held_interrupts():  # Ctrl-C while a kernel loads would be lost (interrupts.py)
-            drive(*args)
+        run_driver(drive, *args)
     if not shape and not out_shape:
         return float(out[0])
     return out.reshape(*shape, *out_shape)

@@ -56,7 +56,6 @@ from .. import _kernels, special
 from .. import shadowing as shd
 from .._kernels import at, driver, jit, sincos
 from ..fresnel import check_index, fresnel_sp
-from ..interrupts import held_interrupts
 from ..registry import Registry
 from .base import Model, PreparedGeometry, register
 from .parameters import Parameter, nonnegative, positive, reflectance
@@ -288,13 +287,6 @@ def _rb08_general(a, sa, b, sb, c, sc, g, sg, ns, sns, nr, snr, p, flag, out):  
                               p, flag, False, False)
 
 
-def _dense_array(x: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
-    # a contiguous 1-D array of the broadcast shape (size 1 for a scalar shape)
-    if x.shape == shape and x.flags.c_contiguous:
-        return x.reshape(-1)
-    return np.ascontiguousarray(np.broadcast_to(x, shape)).reshape(-1)
-
-
 def _run(ti, tr, phi, gamma, p: tuple, flag: int, ns=None, nr=None):
     """Broadcast the inputs and run the fast or the general driver (``ns``/``nr``: numeric N).
 
@@ -312,18 +304,17 @@ def _run(ti, tr, phi, gamma, p: tuple, flag: int, ns=None, nr=None):
         if p[_FAST] == 1.0 and gamma.size == 1 and ns is None and nr is None:
             lean = p[_WA] == 0.0 and p[_SAME_V] == 1.0
             drive = _rb08_fast_lean if lean else _rb08_fast
-            a = float(ti.reshape(-1)[0]) if ti.size == 1 else _dense_array(ti, shape)
-            with held_interrupts():  # Ctrl-C while a kernel loads would be lost
-                drive(a, _dense_array(tr, shape), _dense_array(phi, shape),
-                      float(gamma.reshape(-1)[0]), pt, int(flag), out)
+            a = float(ti.reshape(-1)[0]) if ti.size == 1 else _kernels.broadcast_array(ti, shape)
+            _kernels.run_driver(drive, a, _kernels.broadcast_array(tr, shape),
+                                _kernels.broadcast_array(phi, shape),
+                                float(gamma.reshape(-1)[0]), pt, int(flag), out)
         else:
             flat = _kernels.broadcast_strided
             nan = np.full(1, math.nan)
             args = (*flat(ti, shape), *flat(tr, shape), *flat(phi, shape), *flat(gamma, shape),
                     *((nan, 0) if ns is None else flat(ns, shape)),
                     *((nan, 0) if nr is None else flat(nr, shape)), pt, int(flag), out)
-            with held_interrupts():
-                _rb08_general(*args)
+            _kernels.run_driver(_rb08_general, *args)
     if not shape:
         return float(out[0])
     return out.reshape(shape)

@@ -30,7 +30,7 @@ from typing import Any, NoReturn
 from ..errors import ArgumentError
 
 __all__ = ["Parameter", "REFLECTANCE_DOMAIN", "ReadOnlyDict", "nonnegative", "positive",
-           "reflectance", "unit_interval"]
+           "reflectance"]
 
 #: the one physical domain of every reflectance-like parameter, ``[0, 1]``
 #: (``(low, low_inclusive, high, high_inclusive)``)
@@ -135,7 +135,6 @@ def reflectance(name: str, default: float, desc: str,
 
 
 #: the former name of :func:`reflectance` (same domain)
-unit_interval = reflectance
 
 
 class ReadOnlyDict(dict):

@@ -25,7 +25,7 @@ _os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 from typing import TYPE_CHECKING as _TYPE_CHECKING  # noqa: E402
 
 if _TYPE_CHECKING:  # for type checkers and IDEs; at run time the names load on first use
-    from . import distributions, fresnel, geometry, shadowing
+    from . import diffuse, distributions, fresnel, geometry, shadowing
     from .fitting import FitResult, fit
     from .integrate import albedo, reciprocity_error
     from .io import read, write
@@ -37,6 +37,7 @@ __version__ = "0.1.0"
 __all__ = [
     "albedo",
     "available",
+    "diffuse",
     "distributions",
     "fit",
     "FitResult",
@@ -72,7 +73,7 @@ _ATTRS = {
 #: submodules reachable as attributes (``rb.geometry``) without importing them first: the public
 #: ones of ``__all__`` and those an eager ``import roughbrdf`` used to load as a side effect
 _SUBMODULES = frozenset({
-    "distributions", "fresnel", "geometry", "shadowing", "fitting", "integrate", "io",
+    "diffuse", "distributions", "fresnel", "geometry", "shadowing", "fitting", "integrate", "io",
     "measurement", "models", "polarization", "quantity", "registry", "special",
 })
 

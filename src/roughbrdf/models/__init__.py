@@ -6,9 +6,11 @@
 """
 
 from .base import MODELS, Model, PreparedGeometry, SumModel, register
+from .coated import Coated
 from .factory import available, model, resolve_names
 from .lambertian import Lambertian
 from .microfacet import Microfacet
+from .oren_nayar import OrenNayar
 from .parameters import Parameter
 from .renhorn_boreman import RenhornBoreman2008
 from .torrance_sparrow import TorranceSparrow1967
@@ -24,8 +26,10 @@ __all__ = [
     "model",
     "register",
     "resolve_names",
+    "Coated",
     "Lambertian",
     "Microfacet",
+    "OrenNayar",
     "RenhornBoreman2008",
     "TorranceSparrow1967",
     "TrowbridgeReitz1975",

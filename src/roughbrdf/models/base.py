@@ -115,24 +115,25 @@ class Model:
     _drive: ClassVar[Callable | None] = None
 
     def __init__(self, **kwargs: Any) -> None:
-        specs = {p.name: p for p in self._parameter_specs()}
+        # options first: a model's parameters may depend on them (coated ``lobes``, ``diffuse``)
         options = dict(self._option_defaults())
+        options.update({k: v for k, v in kwargs.items() if k in options})
+        self._options = self._check_options(options)
+        self._specs = self._parameter_specs()
+        specs = {p.name: p for p in self._specs}
         values: dict[str, float | None] = {n: p.value for n, p in specs.items()}
         for key, val in kwargs.items():
             if key in specs:
                 values[key] = specs[key].check(val)
-            elif key in options:
-                options[key] = val
-            else:
+            elif key not in options:
                 raise unknown_name(f"parameter for model {self.name!r}", key,
                                    [*specs, *options])
-        self._options = self._check_options(options)
-        self._specs = self._parameter_specs()
         self._values = values
         self._validate()
 
     # -- hooks ----------------------------------------------------------------------------------
     def _parameter_specs(self) -> tuple[Parameter, ...]:
+        """The parameters for the model's options (``self._options`` is set when called)."""
         return self.PARAMETERS
 
     def _option_defaults(self) -> dict[str, Any]:
@@ -195,9 +196,16 @@ class Model:
         return [p.name for p in self._specs]
 
     def with_params(self, **updates: Any) -> Model:
-        """A copy with some parameters (or options) changed."""
-        kw = {**self._options, **self._values, **updates}
-        return type(self)(**kw)
+        """A copy with some parameters (or options) changed.
+
+        Parameters that a changed option removes (e.g. ``alpha2`` when a coated model goes
+        from ``lobes=2`` to ``lobes=1``) are dropped; the ones it adds take their defaults.
+        """
+        options = {**self._options, **{k: v for k, v in updates.items() if k in self._options}}
+        names = set(type(self)(**options).param_names) if options != self._options \
+            else set(self._values)
+        kept = {k: v for k, v in self._values.items() if k in names}
+        return type(self)(**{**options, **kept, **updates})
 
     def with_values(self, names: Sequence[str], values: Sequence[float]) -> Model:
         """A copy with the named parameters set to ``values`` (validated)."""

@@ -134,8 +134,6 @@ def reflectance(name: str, default: float, desc: str,
     return Parameter(name, default, bounds, "1", desc, REFLECTANCE_DOMAIN, kind="reflectance")
 
 
-#: the former name of :func:`reflectance` (same domain)
-
 
 class ReadOnlyDict(dict):
     """A ``dict`` that cannot be changed in place: what ``Model.params`` and ``Model.options``

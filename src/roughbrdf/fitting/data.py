@@ -6,7 +6,9 @@
   data, BRDF cos(theta_r) (TR75's BRIDF) for ``brdf_cos``/``bridf`` data, and for ``relative``
   data what they are proportional to (``relative_to``);
 * :func:`prepare_channel` -- the samples of one channel that enter the fit, as a
-  :class:`ChannelData`. Samples are never dropped silently: non-finite values raise or are
+  :class:`ChannelData`. Samples are never dropped silently: values the file holds but the
+  instrument did not measure (:mod:`roughbrdf.extrapolation`) are left out unless
+  ``extrapolated="keep"``; non-finite values raise or are
   dropped (``nonfinite``), negative ones are kept, dropped or clipped (``negative``), samples of
   weight 0, outside the fit domain the user chose (``theta_r_max``, ``source_exclusion``:
   :func:`outside_fit_domain`), where the model is not finite or not defined, and (BRDF cos data
@@ -26,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import ArgumentError
+from ..extrapolation import extrapolated_mask
 from ..instrument import Aperture, InstrumentGeometry
 from ..quantity import LOSSES, Quantity
 
@@ -38,6 +41,7 @@ __all__ = ["Comparison", "ChannelData", "DataOptions", "EXCLUSION_REASONS", "cha
 
 #: the reasons a sample is left out or changed, in the order reports list them
 EXCLUSION_REASONS: dict[str, str] = {
+    "extrapolated": "not measured (the file's extrapolation beyond the instrument's range)",
     "nonfinite": "non-finite",
     "negative": "negative (dropped)",
     "clipped": "negative (clipped)",
@@ -130,6 +134,7 @@ class DataOptions:
     aperture: Aperture | None = None
     theta_r_max: float | None = None
     source_exclusion: float | None = None
+    extrapolated: str = "drop"
 
     def __post_init__(self) -> None:
         t_max, excl = check_fit_domain(self.theta_r_max, self.source_exclusion)
@@ -143,6 +148,9 @@ class DataOptions:
         if not isinstance(self.negative, str) or self.negative not in ("keep", "drop", "clip"):
             raise ArgumentError("negative", "must be 'keep', 'drop' or 'clip'",
                                 value=self.negative)
+        if not isinstance(self.extrapolated, str) or self.extrapolated not in ("drop", "keep"):
+            raise ArgumentError("extrapolated", "must be 'drop' or 'keep'",
+                                value=self.extrapolated)
 
 
 def _domain_angle(argument: str, value: Any, high: float, need: str) -> float | None:
@@ -326,8 +334,9 @@ def _bad_values(x: np.ndarray, keep: np.ndarray, excluded: dict[str, int],
                 opts: DataOptions, place: str) -> None:
     """Non-finite and negative values (non-positive for the log loss): raise, drop or clip.
 
-    Updates ``x`` (clipping), ``keep`` and ``excluded`` in place."""
-    bad = ~np.isfinite(x)
+    Only the samples still kept count. Updates ``x`` (clipping), ``keep`` and ``excluded`` in
+    place."""
+    bad = keep & ~np.isfinite(x)
     if bad.any():
         if opts.nonfinite == "raise":
             rows = np.flatnonzero(bad)
@@ -337,7 +346,7 @@ def _bad_values(x: np.ndarray, keep: np.ndarray, excluded: dict[str, int],
         keep &= ~bad
         excluded["nonfinite"] = int(bad.sum())
     log = opts.loss == "log"
-    neg = np.isfinite(x) & ((x <= 0) if log else (x < 0))
+    neg = keep & np.isfinite(x) & ((x <= 0) if log else (x < 0))
     if not neg.any():
         return
     if opts.negative == "keep":
@@ -352,6 +361,16 @@ def _bad_values(x: np.ndarray, keep: np.ndarray, excluded: dict[str, int],
         pos = x[np.isfinite(x) & (x > 0)]
         x[neg] = (pos.min() if pos.size else 1.0) if log else 0.0
         excluded["clipped"] = int(neg.sum())
+
+
+def _not_measured(meas: Measurement, keep: np.ndarray, excluded: dict[str, int],
+                  opts: DataOptions) -> None:
+    """Leave out the samples the reader found extrapolated (:mod:`roughbrdf.extrapolation`)."""
+    if opts.extrapolated == "keep":
+        return
+    out = extrapolated_mask(meas.theta_r, meas.meta.get("extrapolated_beyond"))
+    excluded["extrapolated"] = int(out.sum())
+    keep &= ~out
 
 
 def _fit_domain(meas: Measurement, keep: np.ndarray, excluded: dict[str, int],
@@ -413,6 +432,7 @@ def prepare_channel(model: Model, meas: Measurement, j: int, opts: DataOptions) 
     x = meas.values[:, j].astype(float).copy()
     keep = np.ones(x.size, dtype=bool)
     excluded = dict.fromkeys(EXCLUSION_REASONS, 0)
+    _not_measured(meas, keep, excluded, opts)
     _bad_values(x, keep, excluded, opts, place)
     w = channel_weights(opts.weights, meas, j, x, opts.loss)
     if w is not None:

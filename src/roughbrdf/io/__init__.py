@@ -41,6 +41,7 @@ import re
 from pathlib import Path
 from typing import Any
 
+from ..extrapolation import mark_extrapolated
 from ..measurement import Measurement
 from ._common import FormatError, FormatWarning, LossyWriteWarning, UnterminatedRowWarning
 
@@ -140,12 +141,22 @@ def read(path: str | os.PathLike, format: str | None = None, **options: Any) -> 
         Anything wrong with the file, naming it and, where one line is at fault, the line.
     FileNotFoundError
         No file at ``path``.
+
+    Notes
+    -----
+    Values the instrument did not measure (a linear extrapolation to 0 at ``theta_r = 90``
+    deg, :mod:`roughbrdf.extrapolation`) are recorded as ``meta["extrapolated_beyond"]``
+    (radians); fits leave them out unless asked.
     """
     p = Path(path)
     if not p.exists():
         raise FileNotFoundError(f"{p}: no such file")
     fmt = format_for(p, format)
-    return _module(fmt).read(p, **options)
+    measurement = _module(fmt).read(p, **options)
+    # samples the instrument's software filled in (roughbrdf.extrapolation): recorded in meta,
+    # left out by fits unless asked; the values are not changed
+    mark_extrapolated(measurement)
+    return measurement
 
 
 def write(measurement: Measurement, path: str | os.PathLike, format: str | None = None, *,

@@ -36,9 +36,11 @@ import time
 from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
+from ..errors import ArgumentError
 from ..instrument import APERTURE_POINTS, Aperture, aperture_average, aperture_stencil
 from ..quantity import LOSSES
 from .data import ChannelData, Comparison, DataOptions, prepare_channel
+from .joint import fit_joint
 from .objective import Objective, ObjectiveSpec
 from .result import ChannelFit, FitResult, input_source
 from .search import MultiStart, SearchOptions, progress_bar
@@ -70,7 +72,8 @@ def fit(model: Model | str, measurement: Measurement, *,
         screen: int = 64, subsample: int | None = 1000, polish: int = 2,
         max_nfev: int | None = None, aperture: float | None = None,
         aperture_points: int = 19, theta_r_max: float | None = None,
-        source_exclusion: float | None = None,
+        source_exclusion: float | None = None, extrapolated: str = "drop",
+        joint: bool = False, shared: Iterable[str] | None = None,
         progress: bool | None = None) -> FitResult:
     """Fit ``model`` to ``measurement``, each channel on its own.
 
@@ -143,6 +146,18 @@ def fit(model: Model | str, measurement: Measurement, *,
         (radians, ``0 <= source_exclusion <= pi``) from the direction toward the source (the
         retro direction ``theta_r = theta_i, phi = pi``), e.g. where the source blocks the
         detector; counted in ``excluded``. None: no exclusion.
+    extrapolated : {"drop", "keep"}
+        Samples the file holds but the instrument did not measure (``meta["extrapolated_beyond"]``
+        set by :func:`roughbrdf.read`, :mod:`roughbrdf.extrapolation`; e.g. the Mini-Diff's
+        linear ramp to 0 beyond ``theta_r = 75`` deg): left out (counted in ``excluded``) or
+        fitted too.
+    joint : bool
+        Fit all channels at once (:mod:`~roughbrdf.fitting.joint`): the ``shared`` parameters
+        take one value for every channel, the others one per channel. Exactly ``starts``
+        local fits in all (not per channel).
+    shared : iterable of str, optional
+        With ``joint=True``: the free parameters common to all channels. Default: every free
+        parameter that is not a reflectance (roughness, index, lobe scales).
     progress : bool or None
         Show a tqdm progress bar; ``None`` shows it only on an interactive terminal.
 
@@ -167,7 +182,7 @@ def fit(model: Model | str, measurement: Measurement, *,
     chans = channel_indices(measurement, channel)
     ap = Aperture.parse(aperture, aperture_points)
     opts = DataOptions(Comparison.of(measurement, relative_to), loss, weights, nonfinite,
-                       negative, ap, theta_r_max, source_exclusion)
+                       negative, ap, theta_r_max, source_exclusion, extrapolated)
     search = SearchOptions(starts, screen, subsample, polish, max_nfev, seed)
     k_free, k_fixed = data_scale(measurement, free_scale, scale)
     params = FreeParameters.of(model, fix, bounds)
@@ -176,22 +191,26 @@ def fit(model: Model | str, measurement: Measurement, *,
     # every channel first, so that bad input fails before any work
     data = [prepare_channel(model, measurement, j, opts) for j in chans]
     check_enough_data(measurement, data, spec.n_varys)
-    results: list[ChannelFit] = []
-    with progress_bar(progress, len(chans) * search.starts,
-                      f"fit {model_label(model)}") as bar, single_thread_blas():
-        runner = MultiStart(spec, search, None if bar is None else lambda: bar.update(1))
-        for d in data:
-            t0 = time.perf_counter()
-            if bar is not None:
-                bar.set_postfix_str(d.label)
-            obj, outcome = runner.run(d)
-            results.append(ChannelFit.from_search(obj, outcome, time.perf_counter() - t0))
+    if not isinstance(joint, bool):
+        raise ArgumentError("joint", "must be True or False", value=joint)
+    if shared is not None and not joint:
+        raise ArgumentError("shared", "only a joint fit shares parameters", fix="joint=True")
+    runs = search.starts * (1 if joint else len(chans))
+    with progress_bar(progress, runs, f"fit {model_label(model)}") as bar, \
+            single_thread_blas():
+        tick = None if bar is None else (lambda: bar.update(1))
+        if joint:
+            results, summary = fit_joint(spec, data, search, shared, tick)
+        else:
+            results, summary = _separately(spec, search, data, bar, tick), None
     options = {"starts": search.starts, "seed": seed, "subsample": subsample,
                "polish": search.polish, "nonfinite": nonfinite, "negative": negative,
                "free_scale": k_free, "scale": scale,
                "aperture": None if ap is None else ap.half_angle,
                "aperture_points": None if ap is None else ap.points,
                "theta_r_max": opts.theta_r_max, "source_exclusion": opts.source_exclusion,
+               "extrapolated": extrapolated,
+               "joint": summary,
                "fix": sorted(set(model.param_names) - set(params.names)),
                "weights": None if weights is None else
                (weights if isinstance(weights, str) else "array")}
@@ -202,3 +221,17 @@ def fit(model: Model | str, measurement: Measurement, *,
                      aperture=None if ap is None else ap.half_angle,
                      aperture_points=19 if ap is None else ap.points,
                      source=input_source(measurement))
+
+
+def _separately(spec: ObjectiveSpec, search: SearchOptions, data: list[ChannelData],
+                bar: Any, tick: Any) -> list[ChannelFit]:
+    """Each channel on its own, in order (the previous optimum is a warm start)."""
+    results: list[ChannelFit] = []
+    runner = MultiStart(spec, search, tick)
+    for d in data:
+        t0 = time.perf_counter()
+        if bar is not None:
+            bar.set_postfix_str(d.label)
+        obj, outcome = runner.run(d)
+        results.append(ChannelFit.from_search(obj, outcome, time.perf_counter() - t0))
+    return results

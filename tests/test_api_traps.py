@@ -38,7 +38,7 @@ MODEL_NAMES = rb.available()
 #: ratio), RB08 rho and rho_r (lobe widths).
 REFLECTANCES = {"lambertian": {"rho"}, "trowbridge-reitz-1975": {"rho_L"},
                 "torrance-sparrow-1967": {"rho_d"}, "renhorn-boreman-2008": {"bulk", "retro"},
-                "microfacet": set()}
+                "microfacet": set(), "coated": {"rho"}, "oren-nayar": {"rho"}}
 
 
 # ---------------------------------------------------------------------------------------------

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING as _TYPE_CHECKING  # noqa: E402
 
 if _TYPE_CHECKING:  # for type checkers and IDEs; at run time the names load on first use
     from . import diffuse, distributions, fresnel, geometry, shadowing
-    from .fitting import FitResult, fit
+    from .fitting import FitResult, compare, fit
     from .integrate import albedo, reciprocity_error
     from .io import read, write
     from .measurement import Measurement
@@ -37,6 +37,7 @@ __version__ = "0.1.0"
 __all__ = [
     "albedo",
     "available",
+    "compare",
     "diffuse",
     "distributions",
     "fit",
@@ -58,6 +59,7 @@ __all__ = [
 _ATTRS = {
     "FitResult": "fitting",
     "fit": "fitting",
+    "compare": "fitting",
     "albedo": "integrate",
     "reciprocity_error": "integrate",
     "read": "io",

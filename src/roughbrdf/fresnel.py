@@ -26,6 +26,7 @@ serve as the test oracle.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -237,8 +238,19 @@ def diffuse_reflectance(n: float, k: float = 0.0, *, internal: bool = False) -> 
     check_index(n, k)
     if internal and k != 0.0:
         raise ValueError(f"internal diffuse reflectance needs a dielectric (k = 0), got k={k!r}")
+    external = _external_diffuse_reflectance(float(n), float(k))
+    return 1.0 - (1.0 - external) / (n * n) if internal else external
+
+
+@functools.lru_cache(maxsize=1)
+def _gauss_legendre() -> tuple[np.ndarray, np.ndarray]:
+    """Nodes ``mu`` on [0, 1] and weights ``w mu`` of :data:`_GL_POINTS`-point Gauss-Legendre."""
     x, w = np.polynomial.legendre.leggauss(_GL_POINTS)
     mu = 0.5 * (x + 1.0)
-    r = _reflectance(mu, n, k, math.nan, 0.0)
-    external = float(np.sum(w * r * mu))  # 2 * (1/2 from the interval) * sum
-    return 1.0 - (1.0 - external) / (n * n) if internal else external
+    return mu, w * mu  # 2 * (1/2 from the interval) * w: the factor 2 of F_dr cancels
+
+
+@functools.lru_cache(maxsize=4096)  # a fit asks for the same index many times (Jacobians)
+def _external_diffuse_reflectance(n: float, k: float) -> float:
+    mu, wmu = _gauss_legendre()
+    return float(np.dot(wmu, _reflectance(mu, n, k, math.nan, 0.0)))

@@ -15,7 +15,13 @@ absolute data (``rb.fit(..., free_scale=True)``), ``--theta-r-max DEG`` and
 within that angle of the direction toward the source (``rb.fit(..., theta_r_max=,
 source_exclusion=)`` in radians), ``--no-plots`` skips the figures (and
 Matplotlib). ``--bounds NAME=LOW:HIGH`` overrides a parameter's search range; ``--angles-in``
-states the angle unit of an ASTM or CSV file that does not.
+states the angle unit of an ASTM or CSV file that does not. ``--model auto`` fits the
+candidates of ``roughbrdf.fitting.compare.AUTO_CANDIDATES`` (or those of ``--models``) and keeps
+the lowest BIC, with the comparison in ``fit.json``, the report and ``compare.png``
+(``--no-cv``: without the leave-one-incidence-out score). ``--joint`` fits all channels at
+once with the roughness and index shared (``--shared NAME`` chooses), ``--keep-extrapolated``
+also fits the values a file holds beyond the instrument's range (``rb.fit(...,
+extrapolated="keep")``).
 
 Exit status 1 when the fit did not converge for some channel (the results are written).
 """
@@ -42,7 +48,9 @@ OPTIONS = {"model": "--model", "fix": "--fix", "bounds": "--bounds", "channel": 
            "nonfinite": "--nonfinite", "negative": "--negative", "seed": "--seed",
            "free_scale": "--free-scale", "aperture": "--aperture", "out_dir": "--out",
            "theta_r_max": "--theta-r-max", "source_exclusion": "--source-exclusion",
-           "overwrite": "--force", "plots": "--plots/--no-plots"}
+           "overwrite": "--force", "plots": "--plots/--no-plots", "joint": "--joint",
+           "shared": "--shared", "extrapolated": "--keep-extrapolated",
+           "candidates": "--models", "cv": "--cv/--no-cv"}
 
 #: spellings of --angles-in -> the readers' angles= option
 ANGLE_UNITS = {"deg": "deg", "degree": "deg", "degrees": "deg", "rad": "rad", "radian": "rad",
@@ -149,9 +157,11 @@ def read_input(file: str, file_format: str | None, quantity: str | None,
     return _io.read(file, format=file_format, **opts)
 
 
-def result_names(meas: Measurement, channel: list[str] | None, plots: bool) -> list[str]:
+def result_names(meas: Measurement, channel: list[str] | None, plots: bool,
+                 auto: bool = False) -> list[str]:
     """The files the run will write (``FitResult.save``: ``fit.json``, ``report.txt``,
-    ``fit_<channel>.png`` as :meth:`roughbrdf.FitResult.plot_names` names them)."""
+    ``fit_<channel>.png`` as :meth:`roughbrdf.FitResult.plot_names` names them, and
+    ``compare.png`` for ``--model auto``)."""
     labels = ([meas.channels[meas.channel_index(c)] for c in channel] if channel
               else list(meas.channels))
     names = ["fit.json", "report.txt"]
@@ -159,7 +169,34 @@ def result_names(meas: Measurement, channel: list[str] | None, plots: bool) -> l
         for label in labels:
             safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in label)
             names.append(f"fit_{safe or 'channel'}.png")
+        if auto:
+            names.append("compare.png")
     return names
+
+
+def fit_domain(theta_r_max: float | None, source_exclusion: float | None
+               ) -> tuple[float | None, float | None]:
+    """``--theta-r-max``, ``--source-exclusion`` (degrees) -> radians, checked by the library
+    (errors name the options, in degrees)."""
+    from ..fitting.data import check_fit_domain
+
+    return check_fit_domain(*(None if v is None else math.radians(v)
+                              for v in (theta_r_max, source_exclusion)))
+
+
+def auto_options(models: str | None, param: list[str] | None, fix: list[str] | None,
+                 bounds: list[str] | None, auto: bool) -> None:
+    """Refuse what ``--model auto`` cannot take (and ``--models`` without it)."""
+    if not auto:
+        if models:
+            raise ValueError("--models lists the candidates of --model auto (or use "
+                             "roughbrdf compare)")
+        return
+    for name, given in (("-p/--param", param), ("--fix", fix), ("--bounds", bounds)):
+        if given:
+            raise ValueError(f"{name} names settings of one model; with --model auto the "
+                             f"candidates differ: choose the model, or compare candidates "
+                             f"with roughbrdf compare")
 
 
 def check_aperture(aperture: float | None) -> float | None:
@@ -177,33 +214,37 @@ def run_fit(file: str, model: str, out: str, *, param: list[str] | None,
             angles_in: str | None, quantity: str | None, file_format: str | None,
             aperture: float | None, plots: bool, force: bool, quiet: bool,
             theta_r_max: float | None = None, source_exclusion: float | None = None,
-            **fit_options: Any) -> int:
+            models: str | None = None, cv: bool = True, **fit_options: Any) -> int:
     """The work of ``roughbrdf fit``; returns the exit status (0, or 1 if not converged).
 
     Everything that can be checked is checked before the fit: the options, the input file,
     and that ``out`` may receive the results (:meth:`roughbrdf.output.ResultFolder.check`).
     """
     from ..fitting import fit
-    from ..fitting.data import check_fit_domain
+    from ..fitting.compare import fit_auto
     from ..output import ResultFolder
 
     ap = check_aperture(aperture)
-    # degrees -> radians; checked by the library (errors name the option, in degrees)
-    t_max, excl = check_fit_domain(*(None if v is None else math.radians(v)
-                                     for v in (theta_r_max, source_exclusion)))
-    given = parse_params(param)
-    m = build_model(model, given)
-    fixed = resolve_names(m, list(fix or []))
-    ranges = parse_bounds(m, bounds)
-    m = start_within(m, ranges, given)
+    t_max, excl = fit_domain(theta_r_max, source_exclusion)
+    auto = model.strip().lower() == "auto"
+    auto_options(models, param, fix, bounds, auto)
+    if not auto:
+        given = parse_params(param)
+        m = build_model(model, given)
+        fixed = resolve_names(m, list(fix or []))
+        ranges = parse_bounds(m, bounds)
+        m = start_within(m, ranges, given)
     meas = read_input(file, file_format, quantity, angles_in)
     chans = list(channel) if channel else None
-    ResultFolder(out, overwrite=force).check(result_names(meas, chans, plots))
+    ResultFolder(out, overwrite=force).check(result_names(meas, chans, plots, auto))
     # labels or positions as text; Measurement.channel_index resolves both ("525" also finds
     # "525nm")
-    res = fit(m, meas, channel=chans, fix=fixed, bounds=ranges or None, aperture=ap,
-              theta_r_max=t_max, source_exclusion=excl, progress=None if not quiet else False,
-              **fit_options)
+    common = {"channel": chans, "aperture": ap, "theta_r_max": t_max, "source_exclusion": excl,
+              "progress": None if not quiet else False, **fit_options}
+    if auto:
+        res = fit_auto(meas, models, cv=cv, **common)
+    else:
+        res = fit(m, meas, fix=fixed, bounds=ranges or None, **common)
     written = res.save(out, plots=plots, overwrite=force)
     if not quiet:
         typer.echo(res.report())
@@ -218,8 +259,25 @@ def register(app: typer.Typer) -> None:
         file: str = typer.Argument(..., help="measurement file (.astm, .dat/.alta, .csv, "
                                              ".binary)"),
         model: str = typer.Option(..., "--model", "-m",
-                                  help="model name or sum, e.g. trowbridge-reitz-1975 or "
-                                       "microfacet+lambertian (aliases: roughbrdf models)"),
+                                  help="model name, spec or sum, e.g. trowbridge-reitz-1975, "
+                                       "coated(lobes=2) or microfacet+lambertian (aliases: "
+                                       "roughbrdf models); auto: the lowest BIC of the "
+                                       "candidates (--models)"),
+        models: str = typer.Option(None, "--models", metavar="SPEC,SPEC,...",
+                                   help="with --model auto: the candidates (default: "
+                                        "trowbridge-reitz-1975, coated, coated(lobes=2), "
+                                        "coated(lobes=2, distribution=beckmann))"),
+        cv: bool = typer.Option(True, "--cv/--no-cv",
+                                help="with --model auto: leave-one-incidence-out score"),
+        joint: bool = typer.Option(False, "--joint",
+                                   help="fit all channels at once, roughness and index shared"),
+        shared: Annotated[list[str] | None, typer.Option(
+            "--shared", help="with --joint: a parameter shared by the channels (repeatable; "
+                             "default: all but the reflectances)")] = None,
+        keep_extrapolated: bool = typer.Option(
+            False, "--keep-extrapolated",
+            help="also fit values the file holds beyond the instrument's measured range "
+                 "(default: left out and counted)"),
         out: str = typer.Option(..., "--out", "-o", help="output folder (refused if it holds "
                                                           "results, unless --force)"),
         param: Annotated[list[str] | None, typer.Option(
@@ -277,6 +335,8 @@ def register(app: typer.Typer) -> None:
                            plots=plots,
                            force=force, quiet=quiet, loss=loss, starts=starts, seed=seed,
                            free_scale=free_scale, nonfinite=nonfinite, negative=negative,
-                           relative_to=relative_to)
+                           relative_to=relative_to, models=models, cv=cv, joint=joint,
+                           shared=shared or None,
+                           extrapolated="keep" if keep_extrapolated else "drop")
         if code:
             raise typer.Exit(code)

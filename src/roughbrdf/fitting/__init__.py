@@ -39,6 +39,7 @@ from typing import TYPE_CHECKING, Any
 from ..errors import ArgumentError
 from ..instrument import APERTURE_POINTS, Aperture, aperture_average, aperture_stencil
 from ..quantity import LOSSES
+from .compare import AUTO_CANDIDATES, ModelComparison, compare, fit_auto
 from .data import ChannelData, Comparison, DataOptions, prepare_channel
 from .joint import fit_joint
 from .objective import Objective, ObjectiveSpec
@@ -58,7 +59,8 @@ if TYPE_CHECKING:
     from ..measurement import Measurement
     from ..models import Model
 
-__all__ = ["fit", "FitResult", "ChannelFit", "LOSSES", "APERTURE_POINTS", "aperture_stencil",
+__all__ = ["fit", "compare", "AUTO_CANDIDATES", "ModelComparison", "FitResult", "ChannelFit",
+           "LOSSES", "APERTURE_POINTS", "aperture_stencil",
            "aperture_average", "ChannelData", "Objective", "ObjectiveSpec"]
 
 
@@ -80,7 +82,11 @@ def fit(model: Model | str, measurement: Measurement, *,
     Parameters
     ----------
     model : Model or str
-        Model with starting values (``rb.model(...)``; sums allowed), or a registered name.
+        Model with starting values (``rb.model(...)``; sums allowed), a registered name or
+        spec (``"coated(lobes=2)"``), or ``"auto"``: fit the candidates of
+        :data:`~roughbrdf.fitting.compare.AUTO_CANDIDATES` and keep the lowest BIC, with
+        every candidate's figures and a leave-one-incidence-out score in ``model_choice``
+        (:func:`~roughbrdf.fitting.compare.fit_auto`; ``fix`` and ``bounds`` do not apply).
     measurement : Measurement
         The data (:func:`roughbrdf.read`).
     channel : int, str, list or None
@@ -178,6 +184,15 @@ def fit(model: Model | str, measurement: Measurement, *,
         the command line).
     """
     t_start = time.perf_counter()
+    if isinstance(model, str) and model.strip().lower() == "auto":
+        return fit_auto(measurement, channel=channel, loss=loss, weights=weights, fix=fix,
+                        bounds=bounds, starts=starts, seed=seed, nonfinite=nonfinite,
+                        negative=negative, relative_to=relative_to, free_scale=free_scale,
+                        scale=scale, screen=screen, subsample=subsample, polish=polish,
+                        max_nfev=max_nfev, aperture=aperture, aperture_points=aperture_points,
+                        theta_r_max=theta_r_max, source_exclusion=source_exclusion,
+                        extrapolated=extrapolated, joint=joint, shared=shared,
+                        progress=progress)
     model = as_model(model)
     chans = channel_indices(measurement, channel)
     ap = Aperture.parse(aperture, aperture_points)

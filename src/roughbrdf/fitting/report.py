@@ -50,6 +50,9 @@ def report(result: FitResult, *, min_correl: float = 0.1) -> str:
     lines = _header(result)
     for c in result.channels:
         lines += ["", *_channel(c), *_variables(c), *_correlations(c, min_correl)]
+    if result.model_choice is not None:
+        lines += ["", "[[Model choice]] candidates sorted by BIC (best first; chosen: "
+                  f"{result.model_choice.best.label})", result.model_choice.table()]
     return "\n".join(lines)
 
 
@@ -67,8 +70,28 @@ def _header(result: FitResult) -> list[str]:
             "    aperture           = " + (
                 "none (model at each measured direction)" if ap is None else ap.describe()),
             f"    fit domain         = {_domain_text(result.options)}",
-            f"    channels           = {len(result.channels)}",
+            *_not_measured(result),
+            f"    channels           = {len(result.channels)}" + _joint_text(result.options),
             f"    time               = {result.elapsed:.3g} s"]
+
+
+def _not_measured(result: FitResult) -> list[str]:
+    """The line about samples the file holds but the instrument did not measure, if any."""
+    what = result.measurement.meta.get("extrapolated")
+    if not what:
+        return []
+    done = ("left out (extrapolated='keep' fits them)"
+            if result.options.get("extrapolated", "drop") == "drop" else "fitted (asked)")
+    return [f"    not measured       = {what}: {done}"]
+
+
+def _joint_text(options: dict) -> str:
+    """`` (joint fit: ... shared)`` for a joint fit, else empty."""
+    joint = options.get("joint")
+    if not joint:
+        return ""
+    return (f" (joint fit, shared: {', '.join(joint['shared']) or 'none'}; "
+            f"{joint['n_varys']} unknowns in all, BIC {joint['bic']:.6g})")
 
 
 def _domain_text(options: dict) -> str:

@@ -239,6 +239,9 @@ class FitResult:
     #: the input file as it was when the fit ran: ``{"file", "file_abspath", "file_sha256"}``
     #: (:func:`input_source`; None: taken from the measurement when needed)
     source: dict[str, str | None] | None = field(default=None, repr=False)
+    #: with ``rb.fit("auto", ...)``: the :class:`~roughbrdf.fitting.compare.ModelComparison`
+    #: of the candidates this fit was chosen from (``fit.json``'s ``model_choice``)
+    model_choice: Any = field(default=None, repr=False)
 
     # single-channel shortcuts -------------------------------------------------------------------
     def _one(self, what: str) -> ChannelFit:
@@ -332,6 +335,7 @@ class FitResult:
             "relative_to": self.relative_to, "sample": meta.get("sample"),
             "options": self.options, "aperture": None if ap is None else ap.to_dict(),
             "elapsed_s": self.elapsed, "channels": [c.to_dict() for c in self.channels],
+            "model_choice": None if self.model_choice is None else self.model_choice.to_dict(),
         })
 
     def to_json(self, path: str | os.PathLike | None = None, *, indent: int = 2,
@@ -447,6 +451,8 @@ class FitResult:
         if plots:
             for i, name in enumerate(self.plot_names()):
                 files[name] = _png_writer(self, i, dpi)
+            if self.model_choice is not None:
+                files["compare.png"] = _figure_writer(self.model_choice.plot, dpi)
         return files
 
 
@@ -456,6 +462,13 @@ def _png_writer(result: FitResult, channel: int, dpi: int) -> Callable[[IO[bytes
     def write(fh: IO[bytes]) -> None:
         fig, _ = result.plot(channel)
         fig.savefig(fh, format="png", dpi=dpi, metadata={"Software": "roughbrdf"})
+    return write
+
+
+def _figure_writer(draw: Callable[[], Any], dpi: int) -> Callable[[IO[bytes]], None]:
+    """A function drawing the figure ``draw()`` returns as PNG into the file it is given."""
+    def write(fh: IO[bytes]) -> None:
+        draw().savefig(fh, format="png", dpi=dpi, metadata={"Software": "roughbrdf"})
     return write
 
 

@@ -28,11 +28,11 @@ __all__ = ["BoundsFix", "FreeParameters", "as_model", "channel_indices", "check_
 
 
 def as_model(model: Model | str) -> Model:
-    """``model`` itself, or the registered model of that name (sums ``"a+b"`` allowed)."""
+    """``model`` itself, or the model of that name or spec (``"a+b"``, ``"coated(lobes=2)"``)."""
     if isinstance(model, str):
-        from ..models import model as make_model
+        from ..models import from_spec
 
-        model = make_model(model)
+        model = from_spec(model)
     if not isinstance(model, Model):
         raise TypeError(f"model must be a roughbrdf Model or a model name, got {type(model)}")
     return model

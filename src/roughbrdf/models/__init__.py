@@ -7,7 +7,7 @@
 
 from .base import MODELS, Model, PreparedGeometry, SumModel, register
 from .coated import Coated
-from .factory import available, model, resolve_names
+from .factory import available, from_spec, model, resolve_names, spec_text
 from .lambertian import Lambertian
 from .microfacet import Microfacet
 from .oren_nayar import OrenNayar
@@ -23,9 +23,11 @@ __all__ = [
     "PreparedGeometry",
     "SumModel",
     "available",
+    "from_spec",
     "model",
     "register",
     "resolve_names",
+    "spec_text",
     "Coated",
     "Lambertian",
     "Microfacet",

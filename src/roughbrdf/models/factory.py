@@ -8,7 +8,7 @@ from typing import Any
 from ..registry import unknown_name
 from .base import MODELS, Model, SumModel
 
-__all__ = ["available", "model", "resolve_names"]
+__all__ = ["available", "from_spec", "model", "resolve_names", "spec_text", "split_specs"]
 
 
 def available() -> list[str]:
@@ -95,4 +95,99 @@ def resolve_names(m: Model, names: list[str]) -> list[str]:
             raise ValueError(f"{nm!r} is ambiguous; use one of {', '.join(hit)}")
         else:
             raise unknown_name("parameter", nm, m.param_names)
+    return out
+
+
+def _split_top(text: str, sep: str) -> list[str]:
+    """``text`` split at ``sep`` outside parentheses."""
+    parts, depth, cur = [], 0, ""
+    for ch in text:
+        depth += (ch == "(") - (ch == ")")
+        if ch == sep and depth == 0:
+            parts.append(cur)
+            cur = ""
+        else:
+            cur += ch
+    return [*parts, cur]
+
+
+def _value(text: str) -> Any:
+    """A setting typed in a spec: int, float, true/false/none, else the text."""
+    t = text.strip()
+    low = t.lower()
+    if low in ("true", "false"):
+        return low == "true"
+    if low == "none":
+        return None
+    for conv in (int, float):
+        try:
+            return conv(t)
+        except ValueError:
+            pass
+    return t
+
+
+def from_spec(text: str) -> Model:
+    """A model from a one-line spec: ``NAME(key=value, ...)``, sums joined by ``+``.
+
+    The form :func:`spec_text` writes, and what ``roughbrdf compare --models`` takes
+    (candidates separated by ``;`` or ``,`` outside parentheses there).
+
+    Examples
+    --------
+    >>> m = from_spec("coated(lobes=2, distribution=beckmann)")
+    >>> m.options["lobes"], m.options["distribution"]
+    (2, 'beckmann')
+    >>> from_spec("tr75 + lambertian(rho=0.1)").params["lambertian_rho"]
+    0.1
+    """
+    terms = [t.strip() for t in _split_top(str(text), "+")]
+    parts = []
+    for term in terms:
+        name, _, rest = term.partition("(")
+        if not name.strip() or (rest and not rest.rstrip().endswith(")")):
+            raise ValueError(f"bad model spec {text!r}: expected NAME or NAME(key=value, ...), "
+                             f"sums joined by '+'")
+        kwargs: dict[str, Any] = {}
+        for item in _split_top(rest.rstrip()[:-1], ",") if rest else []:
+            if not item.strip():
+                continue
+            key, eq, val = item.partition("=")
+            if not eq or not key.strip():
+                raise ValueError(f"bad setting {item.strip()!r} in model spec {text!r}: "
+                                 f"expected key=value")
+            kwargs[key.strip()] = _value(val)
+        parts.append(model(name.strip(), **kwargs))
+    return parts[0] if len(parts) == 1 else SumModel(parts)
+
+
+def spec_text(m: Model) -> str:
+    """The short spec of a model: its name and the options that differ from the defaults.
+
+    Examples
+    --------
+    >>> import roughbrdf as rb
+    >>> spec_text(rb.model("coated", lobes=2, distribution="beckmann"))
+    'coated(distribution=beckmann, lobes=2)'
+    >>> spec_text(rb.model("tr75") + rb.model("lambertian"))
+    'trowbridge-reitz-1975+lambertian'
+    """
+    if isinstance(m, SumModel):
+        return "+".join(spec_text(c) for c in m.components)
+    default = type(m)().options
+    changed = [f"{k}={v}" for k, v in m.options.items() if default.get(k) != v]
+    return m.name + (f"({', '.join(changed)})" if changed else "")
+
+
+def split_specs(text: str) -> list[str]:
+    """Model specs separated by ``;`` or by ``,`` outside parentheses.
+
+    Examples
+    --------
+    >>> split_specs("tr75, coated(lobes=2, distribution=beckmann);lambertian")
+    ['tr75', 'coated(lobes=2, distribution=beckmann)', 'lambertian']
+    """
+    out = []
+    for part in str(text).split(";"):
+        out += [s.strip() for s in _split_top(part, ",") if s.strip()]
     return out

@@ -1,0 +1,111 @@
+"""``roughbrdf compare FILE --models SPEC,SPEC,...``: fit candidate models and compare them.
+
+Prints the comparison table (:func:`roughbrdf.compare`: parameters, sigma, rms-log, AIC/BIC,
+rms-log by theta_r band, leave-one-incidence-out score); with ``--out DIR`` also writes
+``compare.md`` (the table), ``compare.json`` (every candidate's figures and parameters) and
+``compare.png`` as one set (:class:`roughbrdf.output.ResultFolder`: no earlier results
+replaced without ``--force``). The fit options are those of ``roughbrdf fit``.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Annotated, Any
+
+import typer
+
+from .common import handled
+from .fit import OPTIONS as FIT_OPTIONS
+from .fit import check_aperture, fit_domain, read_input
+
+OPTIONS = {**FIT_OPTIONS, "candidates": "--models", "cv": "--cv/--no-cv"}
+
+#: the files of ``--out``
+FILES = ("compare.md", "compare.json", "compare.png")
+
+
+def run_compare(file: str, models: str | None, out: str | None, *, force: bool,
+                plots: bool, cv: bool, channel: list[str] | None, angles_in: str | None,
+                quantity: str | None, file_format: str | None, aperture: float | None,
+                theta_r_max: float | None, source_exclusion: float | None,
+                **fit_options: Any) -> int:
+    """The work of ``roughbrdf compare``; returns the exit status (0, or 1 if a candidate's fit
+    did not converge)."""
+    from ..fitting.compare import compare
+    from ..fitting.result import clean_json
+    from ..output import ResultFolder
+
+    ap = check_aperture(aperture)
+    t_max, excl = fit_domain(theta_r_max, source_exclusion)
+    meas = read_input(file, file_format, quantity, angles_in)
+    names = [n for n in FILES if plots or not n.endswith(".png")]
+    if out is not None:
+        ResultFolder(out, overwrite=force).check(names)
+    res = compare(meas, models, cv=cv, channel=list(channel) if channel else None,
+                  aperture=ap, theta_r_max=t_max, source_exclusion=excl, **fit_options)
+    typer.echo(res.table())
+    if out is not None:
+        files: dict[str, Any] = {
+            "compare.md": f"# Model comparison: {meas.meta.get('file')}\n\n{res.table()}\n",
+            "compare.json": json.dumps(clean_json(res.to_dict()), indent=2,
+                                       allow_nan=False) + "\n"}
+        if plots:
+            def draw(fh: Any) -> None:
+                res.plot().savefig(fh, format="png", dpi=110, metadata={"Software": "roughbrdf"})
+            files["compare.png"] = draw
+        with ResultFolder(out, overwrite=force) as folder:
+            for name, content in files.items():
+                folder.add(name, content, binary=callable(content))
+        typer.echo("wrote " + ", ".join(str(folder.path / n) for n in files))
+    return 0 if all(c.result.success for c in res.candidates) else 1
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("compare")
+    def compare_cmd(
+        file: str = typer.Argument(..., help="measurement file"),
+        models: str = typer.Option(None, "--models", metavar="SPEC,SPEC,...",
+                                   help="candidates, e.g. 'tr75, coated(lobes=2)' (default: "
+                                        "the --model auto set)"),
+        out: str = typer.Option(None, "--out", "-o",
+                                help="also write compare.md, compare.json, compare.png here"),
+        cv: bool = typer.Option(True, "--cv/--no-cv",
+                                help="leave-one-incidence-out cross-validation score"),
+        channel: Annotated[list[str] | None, typer.Option(
+            "--channel", "-c", help="channel label or index (repeatable; default: all)")] = None,
+        loss: str = typer.Option("relative", help="relative ((x-f)/f, TR75), log or absolute"),
+        starts: int = typer.Option(8, help="multistart points per channel"),
+        joint: bool = typer.Option(False, "--joint",
+                                   help="fit all channels at once, roughness and index shared"),
+        quantity: str = typer.Option(None, help="input: what the file's values are, if the "
+                                                "file does not say"),
+        angles_in: str = typer.Option(None, "--angles-in", metavar="deg|rad",
+                                      help="input: angle unit of an ASTM or CSV file"),
+        file_format: str = typer.Option(None, "--format", help="override the format chosen "
+                                                               "from the extension"),
+        aperture: float = typer.Option(None, "--aperture", metavar="DEG",
+                                       help="instrument aperture half-angle in degrees"),
+        theta_r_max: float = typer.Option(None, "--theta-r-max", metavar="DEG",
+                                          help="fit domain: leave out theta_r above DEG"),
+        source_exclusion: float = typer.Option(None, "--source-exclusion", metavar="DEG",
+                                               help="fit domain: leave out samples within DEG "
+                                                    "of the direction toward the source"),
+        keep_extrapolated: bool = typer.Option(
+            False, "--keep-extrapolated",
+            help="also fit values the file holds beyond the instrument's measured range"),
+        negative: str = typer.Option("keep", help="negative values: keep, drop or clip"),
+        seed: int = typer.Option(0, help="seed of the Sobol starts and the subsample"),
+        plots: bool = typer.Option(True, "--plots/--no-plots", help="write compare.png"),
+        force: bool = typer.Option(False, "--force", help="replace an earlier run's results"),
+    ) -> None:
+        """Fit candidate models to a file and compare them (sigma, rms-log, AIC/BIC, CV)."""
+        with handled(OPTIONS):
+            code = run_compare(file, models, out, force=force, plots=plots, cv=cv,
+                               channel=channel, angles_in=angles_in, quantity=quantity,
+                               file_format=file_format, aperture=aperture,
+                               theta_r_max=theta_r_max, source_exclusion=source_exclusion,
+                               loss=loss, starts=starts, joint=joint, negative=negative,
+                               seed=seed,
+                               extrapolated="keep" if keep_extrapolated else "drop")
+        if code:
+            raise typer.Exit(code)

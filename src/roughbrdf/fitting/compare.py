@@ -1,0 +1,357 @@
+"""Model choice: fit several candidate models to one measurement and compare them.
+
+:func:`compare` (``rb.compare``, ``roughbrdf compare FILE --models ...``) fits each candidate
+with the same options and tabulates, per candidate: the parameters, TR75's sigma and the rms-log
+(medians over the channels), AIC and BIC, the rms-log by band of ``theta_r`` and, unless
+``cv=False``, a leave-one-incidence-out cross-validation score. ``roughbrdf fit FILE --model
+auto`` fits :data:`AUTO_CANDIDATES` and keeps the lowest BIC (``docs/fitting.md``, "Model
+choice").
+
+Information criteria of a candidate over all its channels (channel ``c``: ``n_c`` samples,
+``chi2_c`` the sum of its squared loss residuals; ``N = sum n_c``; ``k`` the fitted unknowns of
+all channels, free data scales included; for a joint fit the joint count)::
+
+    AIC = sum_c n_c ln(chi2_c/n_c) + 2 k        BIC = sum_c n_c ln(chi2_c/n_c) + ln(N) k
+
+i.e. Gaussian residuals with one variance per channel. **BIC over thousands of correlated
+samples exaggerates differences**: it assumes independent residuals, but neighbouring samples
+of a goniometer share the model's systematic misfit, so ``N`` overstates the information and a
+difference of hundreds of BIC units can come from a detail of the lobe shape. The
+cross-validation score asks a different question -- how well does a model fitted without one
+incidence predict that incidence -- and is the better guide when the two disagree.
+
+Cross-validation (``cv``): for each channel and each incidence angle of the file (at least two),
+the candidate is refitted without that incidence (one local fit started from the full fit's
+optimum, same options) and its loss residuals on the left-out samples are collected; the score
+is their r.m.s. over every fold and channel (unweighted; the left-out samples are those the
+full fit used).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import ArgumentError
+
+if TYPE_CHECKING:
+    from ..measurement import Measurement
+    from ..models import Model
+    from .result import FitResult
+
+__all__ = ["AUTO_CANDIDATES", "THETA_R_BANDS", "Candidate", "ModelComparison", "compare",
+           "cross_validate", "fit_auto", "information"]
+
+#: the candidates of ``--model auto`` for non-retroreflective materials (paints, plastics,
+#: coatings, ceramics): TR75 as published, then the coated model with one and two specular
+#: lobes (GGX, and Beckmann for peaks that fall faster than GGX's tails). Not among them:
+#: RB08 (its retro and bulk terms are for retro-reflectors, and it is slow) and three lobes
+#: (3x the fit time for a small gain on the shared paints); ask for them with ``--models``.
+AUTO_CANDIDATES: tuple[str, ...] = (
+    "trowbridge-reitz-1975",
+    "coated",
+    "coated(lobes=2)",
+    "coated(lobes=2, distribution=beckmann)",
+)
+
+#: bands of theta_r (degrees) of the residual table: [low, high)
+THETA_R_BANDS: tuple[tuple[float, float], ...] = (
+    (0.0, 30.0), (30.0, 60.0), (60.0, 70.0), (70.0, 80.0), (80.0, 90.01))
+
+
+@dataclass
+class Candidate:
+    """One candidate's fit and figures (a row of the comparison table).
+
+    Attributes
+    ----------
+    label : str
+        The candidate's spec (:func:`roughbrdf.models.spec_text`).
+    result : FitResult
+    k, n_points : int
+        Fitted unknowns and samples, all channels.
+    aic, bic : float
+        Over all channels (module notes).
+    sigma, rms_log : float
+        Medians over the channels.
+    bands : dict
+        ``"low-high"`` (deg) -> rms-log of the samples of that theta_r band, all channels
+        (NaN where there are none).
+    cv : float or None
+        Leave-one-incidence-out score (None: not computed).
+    """
+
+    label: str
+    result: FitResult = field(repr=False)
+    k: int
+    n_points: int
+    aic: float
+    bic: float
+    sigma: float
+    rms_log: float
+    bands: dict[str, float]
+    cv: float | None = None
+    elapsed: float = math.nan
+
+    def row(self) -> dict[str, Any]:
+        """The table row as plain values (``fit.json``)."""
+        params = {c.channel: dict(c.params) for c in self.result.channels}
+        return {"model": self.label, "k": self.k, "n_points": self.n_points, "aic": self.aic,
+                "bic": self.bic, "sigma": self.sigma, "rms_log": self.rms_log,
+                "rms_log_by_theta_r": self.bands, "cv": self.cv, "params": params,
+                "elapsed_s": self.elapsed}
+
+
+@dataclass
+class ModelComparison:
+    """The result of :func:`compare`: the candidates, best first by BIC."""
+
+    candidates: list[Candidate]
+    measurement: Measurement = field(repr=False)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def best(self) -> Candidate:
+        """The lowest BIC."""
+        return self.candidates[0]
+
+    @property
+    def best_cv(self) -> Candidate | None:
+        """The lowest cross-validation score (None without one)."""
+        scored = [c for c in self.candidates if c.cv is not None and math.isfinite(c.cv)]
+        return min(scored, key=lambda c: c.cv) if scored else None  # type: ignore[arg-type,return-value]
+
+    def table(self) -> str:
+        """The comparison as a Markdown table, with the notes below it."""
+        bands = list(self.best.bands)
+        head = ["model", "k", "sigma", "rms-log", "dBIC", "dAIC", "CV",
+                *[f"rms-log {b}" for b in bands], "time (s)"]
+        lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        b0, a0 = self.best.bic, min(c.aic for c in self.candidates)
+        for c in self.candidates:
+            cells = [c.label, str(c.k), f"{c.sigma:.3f}", f"{c.rms_log:.3f}",
+                     f"{c.bic - b0:.0f}", f"{c.aic - a0:.0f}",
+                     "-" if c.cv is None else f"{c.cv:.4f}",
+                     *[_num(c.bands[b]) for b in bands], f"{c.elapsed:.1f}"]
+            lines.append("| " + " | ".join(cells) + " |")
+        return "\n".join(lines + [""] + [f"- {n}" for n in self.notes])
+
+    def to_dict(self) -> dict[str, Any]:
+        """``{"best", "best_cv", "criterion", "candidates": [row...], "notes"}``."""
+        cv = self.best_cv
+        return {"best": self.best.label, "best_cv": None if cv is None else cv.label,
+                "criterion": "bic", "candidates": [c.row() for c in self.candidates],
+                "notes": list(self.notes)}
+
+    def plot(self, *, fig: Any = None) -> Any:
+        """rms-log by theta_r band for each candidate (lines), and BIC differences (bars)."""
+        if fig is None:
+            from matplotlib.figure import Figure
+
+            fig = Figure(figsize=(10, 4), layout="constrained")
+        ax1, ax2 = fig.subplots(1, 2)
+        bands = list(self.best.bands)
+        for c in self.candidates:
+            ax1.plot(range(len(bands)), [c.bands[b] for b in bands], marker="o", label=c.label)
+        ax1.set_xticks(range(len(bands)), [f"{b} deg" for b in bands], fontsize=8)
+        ax1.set_xlabel("theta_r band")
+        ax1.set_ylabel("rms of ln(data/model)")
+        ax1.legend(fontsize=7)
+        ax1.set_title(self.measurement.meta.get("sample") or "model comparison", fontsize=9)
+        dbic = [c.bic - self.best.bic for c in self.candidates]
+        ax2.barh(range(len(dbic)), dbic)
+        ax2.set_yticks(range(len(dbic)), [c.label for c in self.candidates], fontsize=7)
+        ax2.invert_yaxis()
+        ax2.set_xlabel("BIC - best BIC")
+        return fig
+
+
+def _num(v: float) -> str:
+    return "-" if not math.isfinite(v) else f"{v:.3f}"
+
+
+def information(result: FitResult) -> tuple[int, int, float, float]:
+    """``(k, N, AIC, BIC)`` of a fit over all its channels (module notes)."""
+    joint = result.options.get("joint")
+    n = sum(c.n_points for c in result.channels)
+    k = joint["n_varys"] if joint else sum(c.n_varys for c in result.channels)
+    like = sum(c.n_points * math.log(c.chi2 / c.n_points) if c.chi2 > 0 else -math.inf
+               for c in result.channels)
+    return k, n, like + 2 * k, like + math.log(n) * k
+
+
+def band_rms_log(result: FitResult) -> dict[str, float]:
+    """rms-log of the fitted samples by theta_r band (:data:`THETA_R_BANDS`), all channels."""
+    tr = np.degrees(result.measurement.theta_r)
+    logs, where = [], []
+    for c in result.channels:
+        x = c.scale * c.data
+        ok = (x > 0) & (c.fitted > 0)
+        logs.append(np.log(x[ok] / c.fitted[ok]))
+        where.append(tr[c.index][ok])
+    lr, t = np.concatenate(logs), np.concatenate(where)
+    out = {}
+    for lo, hi in THETA_R_BANDS:
+        sel = (t >= lo) & (t < hi)
+        out[f"{lo:g}-{min(hi, 90.0):g}"] = float(np.sqrt(np.mean(lr[sel] ** 2))) \
+            if sel.any() else math.nan
+    return out
+
+
+def _loss_residual(loss: str, x: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """The (unweighted) loss residual of data ``K x`` against model ``f``
+    (:mod:`~roughbrdf.fitting.objective`; ``f`` floored like there)."""
+    fs = np.maximum(f, 1e-12 * max(float(np.max(np.abs(x))), 1e-300))
+    if loss == "relative":
+        return x / fs - 1.0
+    if loss == "absolute":
+        return x - f
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(x > 0, np.log(np.where(x > 0, x, 1.0)) - np.log(fs), np.nan)
+
+
+def cross_validate(result: FitResult, fit_options: dict[str, Any]) -> float:
+    """Leave-one-incidence-out score of a fit (module notes); NaN with a single incidence."""
+    from . import fit
+
+    meas = result.measurement
+    angles = meas.incidences()
+    if angles.size < 2:
+        return math.nan
+    joint = bool(result.options.get("joint"))
+    # one local fit on all training samples from the full optimum (no exploration stage: the
+    # start is already in the basin)
+    opts = {k: v for k, v in fit_options.items()
+            if k not in ("starts", "progress", "channel", "joint", "shared", "subsample")}
+    held: list[np.ndarray] = []
+    for g in angles:
+        out = np.abs(meas.theta_i - g) < 1e-6
+        train = meas.subset(~out)
+        groups = [result.channels] if joint else [[c] for c in result.channels]
+        for group in groups:
+            labels = [c.channel for c in group]
+            fold = fit(group[0].model, train, channel=labels, starts=1, progress=False,
+                       subsample=None,
+                       joint=joint, shared=result.options["joint"]["shared"] if joint else None,
+                       **opts)
+            for c, fc in zip(group, fold.channels, strict=True):
+                idx = c.index[out[c.index]]
+                if idx.size == 0:
+                    continue
+                f = fold.predict(meas.theta_i[idx], meas.theta_r[idx], meas.phi[idx],
+                                 channel=c.channel,
+                                 polarization=None if meas.polarization is None
+                                 else meas.polarization[idx])
+                x = fc.scale * meas.values[idx, meas.channel_index(c.channel)]
+                held.append(_loss_residual(result.loss, x, np.asarray(f)))
+    r = np.concatenate(held) if held else np.array([])
+    r = r[np.isfinite(r)]
+    return float(np.sqrt(np.mean(r * r))) if r.size else math.nan
+
+
+def _as_candidates(candidates: Sequence[Model | str] | str | None) -> list[Model]:
+    from ..models import Model, from_spec
+
+    if candidates is None:
+        candidates = AUTO_CANDIDATES
+    if isinstance(candidates, str):
+        from ..models.factory import split_specs
+
+        candidates = split_specs(candidates)
+    models = []
+    for c in candidates:
+        if isinstance(c, Model):
+            models.append(c)
+        elif isinstance(c, str):
+            try:
+                models.append(from_spec(c))
+            except ValueError as exc:
+                raise ArgumentError("candidates", str(exc), value=c) from None
+        else:
+            raise ArgumentError("candidates", "each candidate must be a model or a model spec "
+                                "such as 'coated(lobes=2)'", value=c)
+    if not models:
+        raise ArgumentError("candidates", "no candidate to compare", value=candidates)
+    return models
+
+
+def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | None = None,
+            *, cv: bool = True, **fit_options: Any) -> ModelComparison:
+    """Fit each candidate to ``measurement`` and compare them (module notes).
+
+    Parameters
+    ----------
+    measurement : Measurement
+    candidates : list of Model or str, or str, optional
+        Models, or specs such as ``"coated(lobes=2, distribution=beckmann)"`` (a string:
+        separated by ``;`` or by ``,`` outside parentheses). Default :data:`AUTO_CANDIDATES`.
+    cv : bool
+        Compute the leave-one-incidence-out score (one local refit per candidate, channel
+        group and incidence).
+    **fit_options
+        Passed to :func:`roughbrdf.fit` for every candidate (``loss``, ``channel``,
+        ``joint``, ``aperture``, ``theta_r_max``, ...).
+
+    Returns
+    -------
+    ModelComparison
+        Candidates sorted by BIC, best first.
+
+    Examples
+    --------
+    >>> import numpy as np, roughbrdf as rb
+    >>> g = np.radians(np.mgrid[0:61:30, 0:81:10, 0:181:45].reshape(3, -1))
+    >>> truth = rb.model("coated", n=1.5, rho=0.4, alpha=0.2)
+    >>> meas = rb.Measurement(*g, truth.brdf(*g))
+    >>> res = rb.compare(meas, ["lambertian", "coated"], starts=2)
+    >>> res.best.label, round(res.best.sigma, 6)
+    ('coated', 0.0)
+    """
+    from ..models import spec_text
+    from . import fit
+
+    models = _as_candidates(candidates)
+    rows: list[Candidate] = []
+    for m in models:
+        res = fit(m, measurement, **{"progress": False, **fit_options})
+        k, n, aic, bic = information(res)
+        rows.append(Candidate(
+            spec_text(m), res, k, n, aic, bic,
+            float(np.median([c.sigma for c in res.channels])),
+            float(np.median([c.rms_log for c in res.channels])), band_rms_log(res),
+            cross_validate(res, fit_options) if cv else None, res.elapsed))
+    rows.sort(key=lambda c: c.bic)
+    notes = ["BIC and AIC assume independent residuals; neighbouring samples share the "
+             "models' systematic misfit, so differences of this size overstate the evidence. "
+             "CV: r.m.s. loss residual of each incidence predicted by a fit without it "
+             "(lower is better)."]
+    if len({c.n_points for c in rows}) > 1:
+        notes.append("the candidates were fitted on different numbers of samples (the "
+                     "model's own domain differs): their AIC/BIC are not comparable")
+    best_cv = ModelComparison(rows, measurement).best_cv
+    if best_cv is not None and best_cv is not rows[0]:
+        notes.append(f"cross-validation prefers {best_cv.label} (BIC: {rows[0].label})")
+    return ModelComparison(rows, measurement, notes)
+
+
+def fit_auto(measurement: Measurement, candidates: Sequence[Model | str] | str | None = None,
+             *, cv: bool = True, **fit_options: Any) -> FitResult:
+    """``rb.fit("auto", ...)``: :func:`compare` the candidates and return the best fit by BIC,
+    with the comparison attached (``FitResult.model_choice``: in ``fit.json``, the report and
+    ``compare.png``)."""
+    for name in ("fix", "bounds"):
+        if fit_options.get(name):
+            raise ArgumentError(name, "names parameters of one model; with model 'auto' the "
+                                "candidates have different parameters: choose the model, or "
+                                "compare candidates (rb.compare)", value=fit_options[name])
+    fit_options = {k: v for k, v in fit_options.items() if k not in ("fix", "bounds")}
+    choice = compare(measurement, candidates, cv=cv, **fit_options)
+    best = choice.best.result
+    best.model_choice = choice
+    best.model_name = choice.best.label
+    best.elapsed = sum(c.result.elapsed for c in choice.candidates)
+    return best

@@ -3,7 +3,9 @@
 Inputs are NumPy angle arrays (structure of arrays: ``theta_i``, ``theta_r``, ``phi``), as a
 user passes them; the time includes validation and the output allocation. Each model is run at
 its default parameters, unpolarized, ``brdf()``; the microfacet model also with the Beckmann
-distribution (its other defaults: Smith height-correlated, Fresnel n = 1.5). Alongside, a plain
+distribution (its other defaults: Smith height-correlated, Fresnel n = 1.5); the coated model
+with one lobe (its default) and with two (GGX, Smith separable, diffuse substrate shadowed by
+the first lobe, Lambertian), and Oren-Nayar at its defaults (sigma = 0.3). Alongside, a plain
 vectorized-NumPy implementation of TR75 (written here, independently of the library, as the
 reference) is timed in the same run, and the speed-up of the compiled kernel over it is printed.
 
@@ -66,11 +68,17 @@ def geometries(n: int = N, seed: int = 20250101) -> tuple[np.ndarray, np.ndarray
 
 
 def _rows() -> list[tuple[str, object]]:
-    """(label, model) per benchmark row: every registered model, plus Beckmann microfacet."""
+    """(label, model) per benchmark row: every registered model, plus Beckmann microfacet and
+    the two-lobe coated model."""
     rows = []
     for name in rb.available():
         m = rb.model(name, **(TR75_PARAMS if name == "trowbridge-reitz-1975" else {}))
         label = name
+        if name == "coated":  # one lobe (the default) and two lobes sharing the interface
+            for mm in (m, rb.model("coated", lobes=2)):
+                k = mm.options["lobes"]
+                rows.append((f"coated ({k} lobe{'s' if k > 1 else ''}, ggx, smith-sep)", mm))
+            continue
         if name == "microfacet":  # GGX and Beckmann, each with its default Smith and Fresnel
             for mm in (m, rb.model("microfacet", distribution="beckmann")):
                 short = {"trowbridge-reitz": "ggx", "smith-height-correlated": "smith-hc",

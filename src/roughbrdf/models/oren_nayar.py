@@ -17,7 +17,9 @@ def _on_point(ti, tr, phi, gamma, p, flag):
     si, ci = sincos(ti)
     sr, cr = sincos(tr)
     cp = sincos(phi)[1]
-    cr = cr if cr > 0.0 else 0.0  # cos(pi/2) rounds to 6e-17: exactly 0 at theta_r = pi/2
+    # cos(pi/2) rounds to 6e-17: below 1e-15 it is exactly 0 (theta_r = pi/2 is exactly
+    # grazing, docs/models.md §1.1, as in geometry.half_vector), so bridf is 0 on the horizon
+    cr = 0.0 if cr < 1e-15 else cr
     f = p[0] / math.pi * oren_nayar_factor(ci, cr, si, sr, cp, p[1])
     return f * cr if flag else f
 

@@ -79,7 +79,7 @@ def _ramp_start(theta_r: np.ndarray, values: np.ndarray) -> float | None:
     if abs(theta_r[top] - 0.5 * math.pi) > 1e-9:
         return None
     start = None
-    for c in range(top - MIN_RAMP_SAMPLES + 1, -1, -1):
+    for c in range(top - MIN_RAMP_SAMPLES, -1, -1):  # c + 1 .. top: MIN_RAMP_SAMPLES
         x_c = values[c]
         tail = values[c + 1:]
         if not np.any(x_c != 0.0):

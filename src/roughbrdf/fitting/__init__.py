@@ -209,7 +209,9 @@ def fit(model: Model | str, measurement: Measurement, *,
     if not isinstance(joint, bool):
         raise ArgumentError("joint", "must be True or False", value=joint)
     if shared is not None and not joint:
-        raise ArgumentError("shared", "only a joint fit shares parameters", fix="joint=True")
+        named = shared if isinstance(shared, str) else ", ".join(map(str, shared))
+        raise ArgumentError("shared", "only a joint fit shares parameters: ask for one with "
+                            "joint=True (command line: --joint)", value=named)
     runs = search.starts * (1 if joint else len(chans))
     with progress_bar(progress, runs, f"fit {model_label(model)}") as bar, \
             single_thread_blas():

@@ -231,6 +231,8 @@ def cross_validate(result: FitResult, fit_options: dict[str, Any]) -> float:
     for g in angles:
         out = np.abs(meas.theta_i - g) < 1e-6
         train = meas.subset(~out)
+        if "weights" in opts:  # an array of weights, one per sample: the training samples'
+            opts["weights"] = _subset_weights(fit_options["weights"], meas.n_samples, ~out)
         groups = [result.channels] if joint else [[c] for c in result.channels]
         for group in groups:
             labels = [c.channel for c in group]
@@ -251,6 +253,15 @@ def cross_validate(result: FitResult, fit_options: dict[str, Any]) -> float:
     r = np.concatenate(held) if held else np.array([])
     r = r[np.isfinite(r)]
     return float(np.sqrt(np.mean(r * r))) if r.size else math.nan
+
+
+def _subset_weights(weights: Any, n: int, keep: np.ndarray) -> Any:
+    """The weights of the samples ``keep`` of a fold: an array with one row per sample is
+    cut like the measurement; None, ``"uncertainty"`` and a broadcast scalar pass as given."""
+    if weights is None or isinstance(weights, str):
+        return weights
+    w = np.asarray(weights)
+    return w[keep] if w.ndim >= 1 and w.shape[0] == n else weights
 
 
 def _as_candidates(candidates: Sequence[Model | str] | str | None) -> list[Model]:

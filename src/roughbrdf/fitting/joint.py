@@ -202,7 +202,8 @@ def fit_joint(spec: ObjectiveSpec, data: Sequence[ChannelData], options: SearchO
               ) -> tuple[list[ChannelFit], dict[str, Any]]:
     """Fit every channel of ``data`` at once (module notes); one :class:`ChannelFit` each,
     and the joint figures (``fit.json``'s ``options.joint``): ``shared``, ``n_varys``,
-    ``n_points``, ``chi2``, ``aic``, ``bic`` of all channels together.
+    ``n_points``, ``chi2``, ``aic``, ``bic`` of all channels together (one residual variance
+    per channel: the definition of :func:`roughbrdf.fitting.compare.information`).
 
     The search is the one of a single channel (:func:`~roughbrdf.fitting.search.search`):
     exactly ``options.starts`` local fits, from the model's values and from screened Sobol
@@ -228,9 +229,11 @@ def fit_joint(spec: ObjectiveSpec, data: Sequence[ChannelData], options: SearchO
     fits = [_channel_fit(full, c, outcome, cov, bound, elapsed) for c in range(len(data))]
     chi2 = sum(f.chi2 for f in fits)
     k, n = layout.n_varys, full.n
-    lchi = math.log(chi2 / n) if chi2 > 0 else -math.inf
+    # one residual variance per channel, as roughbrdf.fitting.compare.information counts it
+    like = sum(f.n_points * math.log(f.chi2 / f.n_points) if f.chi2 > 0 else -math.inf
+               for f in fits)
     summary = {"shared": list(layout.shared), "n_varys": k, "n_points": n, "chi2": chi2,
-               "aic": n * lchi + 2 * k, "bic": n * lchi + math.log(n) * k,
+               "aic": like + 2 * k, "bic": like + math.log(n) * k,
                "cost": float(outcome.result.cost) if outcome.result is not None else None}
     return fits, summary
 
@@ -250,9 +253,11 @@ def _channel_fit(full: JointObjective, c: int, outcome: SearchOutcome, cov: Cova
         stderr[nm] = float(sd[jn])
     label = layout.labels[c]
     corr = cov.correl()
+    rows = list(zip(layout.spec.free, names, strict=True))  # + the scale, as in a separate fit
+    rows += [("scale", f"scale[{label}]")] if layout.spec.free_scale else []
     correl = {nm: {(o if o in layout.shared else o.split("[")[0]): v
                    for o, v in corr[jn].items() if o in layout.shared or o.endswith(f"[{label}]")}
-              for nm, jn in zip(layout.spec.free, names, strict=True)}
+              for nm, jn in rows}
     own_bound = {nm: bound[jn] for nm, jn in zip(layout.spec.free, names, strict=True)
                  if jn in bound}
     message = (outcome.result.message.rstrip(".") if outcome.result is not None
@@ -261,7 +266,11 @@ def _channel_fit(full: JointObjective, c: int, outcome: SearchOutcome, cov: Cova
         + (", ".join(layout.shared) or "none")
     if own_bound:
         message += f"; at a bound: {', '.join(own_bound)}"
+    # covar and the scale's stderr from the joint covariance too (this channel's block)
+    sel = list(idx) + ([len(layout.free) + c] if layout.spec.free_scale else [])
+    scale_sd = float(sd[f"scale[{label}]"]) if layout.spec.free_scale else 0.0
     return replace(fit, stderr=stderr, correl=correl, at_bound=own_bound, message=message,
+                   covar=cov.matrix[np.ix_(sel, sel)], scale_stderr=scale_sd,
                    nfev=full.nfev, n_varys=layout.n_varys,
                    aic=_ic(fit, layout.n_varys, 2.0),
                    bic=_ic(fit, layout.n_varys, math.log(full.n)))

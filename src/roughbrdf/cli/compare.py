@@ -16,7 +16,14 @@ import typer
 
 from .common import handled
 from .fit import OPTIONS as FIT_OPTIONS
-from .fit import check_aperture, fit_domain, read_input
+from .fit import (
+    CvOption,
+    JointOption,
+    KeepExtrapolatedOption,
+    check_aperture,
+    fit_domain,
+    read_input,
+)
 
 OPTIONS = {**FIT_OPTIONS, "candidates": "--models", "cv": "--cv/--no-cv"}
 
@@ -69,14 +76,12 @@ def register(app: typer.Typer) -> None:
                                         "the --model auto set)"),
         out: str = typer.Option(None, "--out", "-o",
                                 help="also write compare.md, compare.json, compare.png here"),
-        cv: bool = typer.Option(True, "--cv/--no-cv",
-                                help="leave-one-incidence-out cross-validation score"),
+        cv: CvOption = True,
         channel: Annotated[list[str] | None, typer.Option(
             "--channel", "-c", help="channel label or index (repeatable; default: all)")] = None,
         loss: str = typer.Option("relative", help="relative ((x-f)/f, TR75), log or absolute"),
         starts: int = typer.Option(8, help="multistart points per channel"),
-        joint: bool = typer.Option(False, "--joint",
-                                   help="fit all channels at once, roughness and index shared"),
+        joint: JointOption = False,
         quantity: str = typer.Option(None, help="input: what the file's values are, if the "
                                                 "file does not say"),
         angles_in: str = typer.Option(None, "--angles-in", metavar="deg|rad",
@@ -90,9 +95,7 @@ def register(app: typer.Typer) -> None:
         source_exclusion: float = typer.Option(None, "--source-exclusion", metavar="DEG",
                                                help="fit domain: leave out samples within DEG "
                                                     "of the direction toward the source"),
-        keep_extrapolated: bool = typer.Option(
-            False, "--keep-extrapolated",
-            help="also fit values the file holds beyond the instrument's measured range"),
+        keep_extrapolated: KeepExtrapolatedOption = False,
         negative: str = typer.Option("keep", help="negative values: keep, drop or clip"),
         seed: int = typer.Option(0, help="seed of the Sobol starts and the subsample"),
         plots: bool = typer.Option(True, "--plots/--no-plots", help="write compare.png"),

@@ -57,6 +57,23 @@ ANGLE_UNITS = {"deg": "deg", "degree": "deg", "degrees": "deg", "rad": "rad", "r
                "radians": "rad"}
 
 
+# the options of model choice, joint fits and the fit domain, shared with `roughbrdf compare`
+ModelsOption = Annotated[str | None, typer.Option(
+    "--models", metavar="SPEC,SPEC,...",
+    help="with --model auto: the candidates (default: trowbridge-reitz-1975, coated, "
+         "coated(lobes=2), coated(lobes=2, distribution=beckmann))")]
+CvOption = Annotated[bool, typer.Option(
+    "--cv/--no-cv", help="leave-one-incidence-out cross-validation score (model choice)")]
+JointOption = Annotated[bool, typer.Option(
+    "--joint", help="fit all channels at once, roughness and index shared")]
+SharedOption = Annotated[list[str] | None, typer.Option(
+    "--shared", help="with --joint: a parameter shared by the channels (repeatable; default: "
+                     "all but the reflectances)")]
+KeepExtrapolatedOption = Annotated[bool, typer.Option(
+    "--keep-extrapolated", help="also fit values the file holds beyond the instrument's "
+                                "measured range (default: left out and counted)")]
+
+
 def build_model(spec: str, params: dict[str, Any] | None = None) -> Model:
     """A model from ``name`` or ``name1+name2`` and ``-p`` settings (:func:`roughbrdf.model`)."""
     from .. import models as _models
@@ -263,21 +280,11 @@ def register(app: typer.Typer) -> None:
                                        "coated(lobes=2) or microfacet+lambertian (aliases: "
                                        "roughbrdf models); auto: the lowest BIC of the "
                                        "candidates (--models)"),
-        models: str = typer.Option(None, "--models", metavar="SPEC,SPEC,...",
-                                   help="with --model auto: the candidates (default: "
-                                        "trowbridge-reitz-1975, coated, coated(lobes=2), "
-                                        "coated(lobes=2, distribution=beckmann))"),
-        cv: bool = typer.Option(True, "--cv/--no-cv",
-                                help="with --model auto: leave-one-incidence-out score"),
-        joint: bool = typer.Option(False, "--joint",
-                                   help="fit all channels at once, roughness and index shared"),
-        shared: Annotated[list[str] | None, typer.Option(
-            "--shared", help="with --joint: a parameter shared by the channels (repeatable; "
-                             "default: all but the reflectances)")] = None,
-        keep_extrapolated: bool = typer.Option(
-            False, "--keep-extrapolated",
-            help="also fit values the file holds beyond the instrument's measured range "
-                 "(default: left out and counted)"),
+        models: ModelsOption = None,
+        cv: CvOption = True,
+        joint: JointOption = False,
+        shared: SharedOption = None,
+        keep_extrapolated: KeepExtrapolatedOption = False,
         out: str = typer.Option(..., "--out", "-o", help="output folder (refused if it holds "
                                                           "results, unless --force)"),
         param: Annotated[list[str] | None, typer.Option(

@@ -7,6 +7,7 @@ astm      ``.astm``             :mod:`roughbrdf.io.astm` (ASTM E1392 text)      
 alta      ``.dat``, ``.alta``   :mod:`roughbrdf.io.alta` (ALTA text)            yes     yes
 merl      ``.binary``, ``.merl``  :mod:`roughbrdf.io.merl` (MERL 2003 binary)   yes     yes
 csv       ``.csv``              :mod:`roughbrdf.io.csv` (roughbrdf CSV)         yes     yes
+zemax     ``.bsdf``             :mod:`roughbrdf.io.zemax` (Zemax tabular BSDF)  yes     yes
 ========  ====================  ==============================================  ======  ======
 
 ``read(path)`` chooses the format from the extension (``format=`` overrides); when the
@@ -30,7 +31,10 @@ file renamed over ``path``: an error or Ctrl-C leaves the old file or none). Wri
 format, a measurement keeps every header key it was read with; what another format has no
 place for is named in a :class:`LossyWriteWarning`. MERL's fixed grid changes most
 measurements' samples, so writing MERL needs ``resample=True`` for them and returns a report of
-what was binned, averaged and dropped (:class:`~roughbrdf.io.merl.MerlWriteReport`).
+what was binned, averaged and dropped (:class:`~roughbrdf.io.merl.MerlWriteReport`). Zemax's
+tabular BSDF is a grid about the specular direction: a measurement read from a ``.bsdf`` (or
+lying on such a grid) is written exactly, any other needs ``resample=True`` and gets a
+:class:`~roughbrdf.io.zemax.ZemaxWriteReport`.
 """
 
 from __future__ import annotations
@@ -49,8 +53,9 @@ __all__ = ["read", "write", "FormatError", "FormatWarning", "LossyWriteWarning",
            "UnterminatedRowWarning", "FORMATS", "format_for"]
 
 #: format name -> module name under roughbrdf.io
-FORMATS = {"astm": "astm", "alta": "alta", "merl": "merl", "csv": "csv"}
-_ALIASES = {"ascii": "alta", "dat": "alta", "binary": "merl", "e1392": "astm", "txt": "alta"}
+FORMATS = {"astm": "astm", "alta": "alta", "merl": "merl", "csv": "csv", "zemax": "zemax"}
+_ALIASES = {"ascii": "alta", "dat": "alta", "binary": "merl", "e1392": "astm", "txt": "alta",
+            "bsdf": "zemax", "opticstudio": "zemax"}
 
 
 def _module(fmt: str):
@@ -99,6 +104,11 @@ def _sniff(path: Path) -> str | None:
     if re.search(r"^VARS\s", text, re.MULTILINE) and re.search(r"^NUM_POINTS\s", text,
                                                                  re.MULTILINE):
         return "astm"
+    # Zemax tabular BSDF: the counted keywords of its header (comments may come first)
+    counted = re.findall(r"^\s*(SampleRotation|AngleOfIncidence|ScatterAzimuth|ScatterRadial)"
+                         r"\s+\d+\s*$", text, re.MULTILINE | re.IGNORECASE)
+    if len({c.lower() for c in counted}) >= 2:
+        return "zemax"
     return None
 
 
@@ -127,11 +137,12 @@ def read(path: str | os.PathLike, format: str | None = None, **options: Any) -> 
     Parameters
     ----------
     path : str or path-like
-    format : {"astm", "alta", "merl", "csv"}, optional
+    format : {"astm", "alta", "merl", "csv", "zemax"}, optional
         Override the format chosen from the extension.
     **options
         Passed to the format's reader, e.g. ``quantity="brdf_cos"`` (ALTA without
-        ``#PARAM_OUT``), ``angles="deg"`` (ASTM), ``stride=4`` (MERL). ``quantity=`` and
+        ``#PARAM_OUT``), ``angles="deg"`` (ASTM), ``stride=4`` (MERL),
+        ``sample_rotation="all"`` (Zemax, several sample rotations). ``quantity=`` and
         ``angles=`` supply what the file does not say; if the file says otherwise they raise
         :class:`FormatError` (every reader accepts both).
 
@@ -168,18 +179,19 @@ def write(measurement: Measurement, path: str | os.PathLike, format: str | None 
     measurement : Measurement
     path : str or path-like
         The file to write; never the file ``measurement`` was read from.
-    format : {"astm", "alta", "merl", "csv"}, optional
+    format : {"astm", "alta", "merl", "csv", "zemax"}, optional
         Override the format chosen from the extension.
     overwrite : bool
         Replace an existing file (default: refuse with :class:`FileExistsError`).
     **options
         Passed to the format's writer, e.g. ``angles="rad"`` (CSV, ASTM), ``resample=True``
-        (MERL: write even though the grid bins, averages or drops samples).
+        (MERL, Zemax: write even though the grid bins, averages or drops samples),
+        ``channel=`` (Zemax: one channel a file).
 
     Returns
     -------
-    MerlWriteReport or None
-        For MERL, what the grid did to the samples; None for the other formats.
+    MerlWriteReport, ZemaxWriteReport or None
+        For MERL and Zemax, what the grid did to the samples; None for the other formats.
 
     Raises
     ------
@@ -187,7 +199,7 @@ def write(measurement: Measurement, path: str | os.PathLike, format: str | None 
         ``path`` exists and ``overwrite`` is false.
     roughbrdf.errors.ArgumentError
         ``path`` is the measurement's own input file (even with ``overwrite=True``), or MERL
-        would change the samples and ``resample`` is false.
+        or Zemax would change the samples and ``resample`` is false.
     IsADirectoryError
         ``path`` is a folder.
     ValueError

@@ -287,10 +287,13 @@ def test_convert_astm_to_merl_refuses_without_resample(shared_data, tmp_path):
     assert len(warning_lines) == 1 and "APERTURE" in warning_lines[0]
 
 
-def test_resample_only_for_merl_output(tmp_path):
+def test_resample_only_for_grid_outputs(tmp_path):
+    # MERL and Zemax write fixed grids; the other formats keep every sample
     src = _file(tmp_path, CSV, "in.csv")
     res = runner.invoke(app, ["convert", str(src), str(tmp_path / "o.dat"), "--resample"])
-    assert res.exit_code == 2 and "--resample applies to MERL output" in res.output
+    assert res.exit_code == 2 and "--resample applies to MERL and Zemax output" in res.output
+    res = runner.invoke(app, ["convert", str(src), str(tmp_path / "o.dat"), "--channel", "1"])
+    assert res.exit_code == 2 and "--channel applies to Zemax output" in res.output
 
 
 def test_astm_round_trip_keeps_every_header_key(tmp_path):

@@ -1,9 +1,10 @@
 """``roughbrdf convert IN OUT``: read any supported measurement file and write another format.
 
-What the conversion cannot carry is said, never hidden: writing MERL (a fixed grid) refuses a
-measurement whose samples it would bin, average or drop unless ``--resample``, and then prints
-what it did; header keys and uncertainties the target has no place for are named in a warning
-line. OUT is never replaced without ``--force`` and never written onto IN.
+What the conversion cannot carry is said, never hidden: writing MERL or Zemax (fixed grids)
+refuses a measurement whose samples it would bin, average or drop unless ``--resample``, and
+then prints what it did (Zemax: one channel per file, ``--channel``); header keys and
+uncertainties the target has no place for are named in a warning line. OUT is never replaced
+without ``--force`` and never written onto IN.
 """
 
 from __future__ import annotations
@@ -21,7 +22,8 @@ HELP_QUANTITIES = ("brdf", "brdf_cos", "bridf", "relative")
 
 #: library argument -> the option of this command that sets it (for ArgumentError messages)
 OPTIONS = {"quantity": "--quantity", "angles": "--angles-in", "stride": "--stride",
-           "overwrite": "--force", "resample": "--resample", "path": "OUT"}
+           "overwrite": "--force", "resample": "--resample", "path": "OUT",
+           "channel": "--channel"}
 #: arguments set by a flag: "pass resample=True" is "pass --resample"
 FLAGS = {"overwrite": "--force", "resample": "--resample"}
 
@@ -82,10 +84,15 @@ def _options(fin: str, fout: str, args: dict[str, Any]) -> tuple[dict[str, Any],
             raise ValueError("--angles-out applies to ASTM and CSV output only")
         wopts["angles"] = args["angles_out"]
     if args["resample"]:
-        if fout != "merl":
-            raise ValueError("--resample applies to MERL output only (the other formats keep "
-                             "every sample)")
+        if fout not in ("merl", "zemax"):
+            raise ValueError("--resample applies to MERL and Zemax output only (the other "
+                             "formats keep every sample)")
         wopts["resample"] = True
+    if args["channel"] is not None:
+        if fout != "zemax":
+            raise ValueError("--channel applies to Zemax output only (one channel per .bsdf "
+                             "file; the other formats keep every channel)")
+        wopts["channel"] = args["channel"]
     return ropts, wopts
 
 
@@ -148,8 +155,8 @@ def register(app: typer.Typer) -> None:
         src: Annotated[Path, typer.Argument(metavar="IN", help="input measurement file")],
         dst: Annotated[Path, typer.Argument(metavar="OUT", help="output file (not overwritten "
                                             "unless --force; never IN)")],
-        from_: str = typer.Option(None, "--from", help="input format (astm, alta, merl, csv); "
-                                  "default from the extension"),
+        from_: str = typer.Option(None, "--from", help="input format (astm, alta, merl, csv, "
+                                  "zemax); default from the extension"),
         to: str = typer.Option(None, "--to", help="output format; default from the extension"),
         quantity: str = typer.Option(None, "--quantity", help="what the input values hold, "
                                      "where the file does not say (it must agree where it "
@@ -163,12 +170,15 @@ def register(app: typer.Typer) -> None:
                                        "rad; CSV default deg, ASTM default rad)"),
         stride: int = typer.Option(None, "--stride", help="MERL input: keep every N-th cell "
                                    "along each axis"),
-        resample: bool = typer.Option(False, "--resample", help="MERL output: write even though "
-                                      "the fixed grid bins, averages or drops samples (the "
-                                      "counts are printed); without it such input is refused"),
+        resample: bool = typer.Option(False, "--resample", help="MERL and Zemax output: write "
+                                      "even though the fixed grid bins, averages or drops "
+                                      "samples (the counts are printed); without it such "
+                                      "input is refused"),
+        channel: str = typer.Option(None, "--channel", help="Zemax output: the channel to "
+                                    "write (label or index; one per .bsdf file)"),
         force: bool = typer.Option(False, "--force", help="overwrite OUT if it exists"),
     ) -> None:
-        """Convert a measurement between formats (astm, alta, merl, csv).
+        """Convert a measurement between formats (astm, alta, merl, csv, zemax).
 
         Non-finite and negative values are carried over and reported, never dropped silently:
         MERL output, a fixed grid, needs --resample when it would change the samples and then
@@ -179,7 +189,7 @@ def register(app: typer.Typer) -> None:
 
         args = {"from_": from_, "to": to, "quantity": quantity, "as_quantity": as_quantity,
                 "angles_in": angles_in, "angles_out": angles_out, "stride": stride,
-                "resample": resample, "force": force}
+                "resample": resample, "force": force, "channel": channel}
         try:
             _convert(src, dst, args)
         except (ArgumentError, FormatError, ValueError, FileNotFoundError,

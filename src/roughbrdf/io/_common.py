@@ -573,11 +573,15 @@ def header_not_written(meta: dict[str, Any], target: str, fields: Iterable[str])
     src = meta.get("format")
     header = meta.get("header")
     if src == target or not isinstance(header, dict) or not header or src not in (
-            "astm", "alta", "csv"):
+            "astm", "alta", "csv", "zemax"):
         return []
     field_of = _header_field(str(src))
     kept = set(fields)
-    return [k for k in header if field_of(k) != LAYOUT and field_of(k) not in kept]
+    lost = [k for k in header if field_of(k) != LAYOUT and field_of(k) not in kept]
+    if src == "zemax":  # what a Zemax table holds besides its header keywords
+        lost += [what for k, what in (("zemax_tis", "TIS"), ("comments", "# comments"))
+                 if meta.get(k)]
+    return lost
 
 
 def warn_not_written(path: Path, target: str, items: Sequence[str]) -> None:

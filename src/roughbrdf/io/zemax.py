@@ -106,6 +106,7 @@ from ..measurement import Measurement
 from ..output import staged
 from ..quantity import Quantity
 from ._common import (
+    LAYOUT,
     FormatError,
     begin_read,
     describe_keys,
@@ -937,8 +938,8 @@ def _brdf_column(m: Measurement, channel: Any) -> np.ndarray:
     if channel is None:
         if m.n_channels != 1:
             raise ArgumentError("channel", f"a .bsdf holds one channel (Monochrome); this "
-                                f"measurement has {m.n_channels} ({m.channels}): pass "
-                                "channel= (a label or index)")
+                                f"measurement has {m.n_channels} ({m.channels}): name one "
+                                "(a label or index)", fix=m.channels[0])
         channel = 0
     j = m.channel_index(channel)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -1227,3 +1228,10 @@ def _comments(m: Measurement, report: ZemaxWriteReport, label: str) -> list[str]
     if report.changes_samples:
         lines.append("resampled onto this grid: " + report.summary())
     return [re.sub(r"[\r\n]+", " ", s) for s in lines]
+
+
+def header_field(key: str) -> str | None:
+    """What a Zemax header keyword holds, for a writer of another format: :data:`LAYOUT` for the
+    table's layout (``Symmetry``, ``SpectralContent``, ``ScatterType``: every writer writes its
+    own), None for the rest (``Source``), which another format has no place for."""
+    return LAYOUT if key in ("Symmetry", "SpectralContent", "ScatterType") else None

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import errno
 import hashlib
-import json
 import math
 import re
 from pathlib import Path
@@ -75,32 +74,6 @@ def _model_figure(model_name: str, params: dict[str, Any], kind: str, theta_i: s
         return rbplot.plot_polar(m, float(ti[0]), math.radians(elevation), label=m.name)
     return rbplot.plot_hemisphere(m, float(ti[0]), quantity=quantity,
                                   log=True if log is None else log)
-
-
-def _read_fit(fit_dir: Path) -> tuple[dict[str, Any], Path]:
-    path = fit_dir / "fit.json" if fit_dir.is_dir() else fit_dir
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: no fit.json (run `roughbrdf fit FILE --out DIR` first)")
-    try:
-        fit = json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{path}: not valid JSON ({exc})") from exc
-    for key in ("model", "file", "channels"):
-        if key not in fit:
-            raise ValueError(f"{path}: missing key {key!r}")
-    return fit, path.parent
-
-
-def _fit_model(fit: dict[str, Any], chan: dict[str, Any]):
-    from .. import models as _models
-
-    spec = chan.get("model_spec")
-    if isinstance(spec, dict):
-        return _models.model(spec)
-    name = fit["model"]
-    if isinstance(name, dict):
-        return _models.model(name, **(chan.get("params") or {}))
-    return _models.model(str(name), **(chan.get("params") or {}))
 
 
 def _fit_aperture(fit: dict[str, Any]):
@@ -194,8 +167,9 @@ def _fit_figure(fit: dict[str, Any], fit_dir: Path, meas: Any, chan: dict[str, A
     from matplotlib.figure import Figure
 
     from .. import plot as rbplot
+    from ..fitting.result import channel_model
 
-    model = _fit_model(fit, chan)
+    model = channel_model(fit, chan)
     label = chan.get("channel")
     ch = meas.channel_index(label) if str(label) in meas.channels else 0
     fig = Figure(figsize=(13, 5.2), layout="constrained")
@@ -212,9 +186,10 @@ def _fit_figures(fit_dir: Path, out: Path | None, channel: str | None, force: bo
                  ) -> list[Path]:
     """Draw the comparison of each channel of the fit in ``fit_dir``: into ``out``, or added to
     the fit's results in its folder; everything is checked before the drawing."""
+    from ..fitting.result import read_fit_json
     from ..output import ResultFolder
 
-    fit, base = _read_fit(fit_dir)
+    fit, base = read_fit_json(fit_dir)
     chans = _fit_channels(fit, channel, out)
     if out is not None:
         _check_out(out, force)

@@ -33,6 +33,7 @@ from __future__ import annotations
 import math
 import os
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -253,10 +254,21 @@ def _models(obj: Any, channel: Any) -> list[tuple[str | None, Model]]:
         if channel is not None:
             raise ArgumentError("channel", "applies to a fit; a model is one file", value=channel)
         return [(None, obj)]
+    if isinstance(obj, Mapping) and obj and all(isinstance(m, Model) for m in obj.values()):
+        # {channel: model}, e.g. roughbrdf.fitting.result.fitted_models(fit folder)
+        if channel is None:
+            return [(str(k), m) for k, m in obj.items()]
+        key = channel if channel in obj else list(obj)[int(channel)] \
+            if str(channel).lstrip("-").isdigit() else None
+        if key is None:
+            raise ArgumentError("channel", f"not a channel of this fit ({', '.join(obj)})",
+                                value=channel)
+        return [(str(key), obj[key])]
     chans = getattr(obj, "channels", None)
     if not chans or not all(isinstance(getattr(c, "model", None), Model) for c in chans):
-        raise TypeError(f"to_zemax takes a roughbrdf Model (rb.model(...)) or a FitResult "
-                        f"(rb.fit(...)), got {type(obj).__name__}")
+        raise TypeError(f"to_zemax takes a roughbrdf Model (rb.model(...)), a FitResult "
+                        f"(rb.fit(...)) or a mapping channel -> Model, got "
+                        f"{type(obj).__name__}")
     if channel is not None:
         c = obj[channel]
         return [(str(c.channel), c.model)]
@@ -302,8 +314,9 @@ def to_zemax(model_or_fit: Any, out: str | os.PathLike, *, angles_of_incidence: 
 
     Parameters
     ----------
-    model_or_fit : Model or FitResult
-        A fit writes one file per channel, ``<stem>_<channel>.bsdf`` beside ``out``.
+    model_or_fit : Model, FitResult or mapping
+        A fit (or ``{channel: model}``, e.g. :func:`roughbrdf.fitting.result.fitted_models` of
+        a saved fit) writes one file per channel, ``<stem>_<channel>.bsdf`` beside ``out``.
     out : str or path-like
         The file (``.bsdf`` added when it has no suffix).
     angles_of_incidence, radial, azimuth : array_like, optional

@@ -32,7 +32,8 @@ if TYPE_CHECKING:
     from .objective import Objective
     from .search import SearchOutcome
 
-__all__ = ["ChannelFit", "FitResult", "input_source"]
+__all__ = ["ChannelFit", "FitResult", "channel_model", "fitted_models", "input_source",
+           "read_fit_json"]
 
 
 @dataclass
@@ -506,3 +507,42 @@ def input_source(meas: Measurement) -> dict[str, str | None]:
             return out
         out["file_sha256"] = h.hexdigest()
     return out
+
+
+def read_fit_json(fit: str | os.PathLike) -> tuple[dict[str, Any], Path]:
+    """The content of a fit's ``fit.json`` (``fit`` is the file or its folder) and its folder.
+
+    Raises ``FileNotFoundError`` without one, ``ValueError`` when it is not a fit's JSON.
+    """
+    path = Path(fit)
+    path = path / "fit.json" if path.is_dir() else path
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no fit.json (run `roughbrdf fit FILE --out DIR` first)")
+    try:
+        content = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{path}: not valid JSON ({exc})") from exc
+    for key in ("model", "file", "channels"):
+        if key not in content:
+            raise ValueError(f"{path}: missing key {key!r}")
+    return content, path.parent
+
+
+def channel_model(fit: dict[str, Any], chan: dict[str, Any]) -> Model:
+    """The fitted model of one channel entry of ``fit.json`` (its ``model_spec``; a fit.json
+    of an older roughbrdf: the model's name and the channel's ``params``)."""
+    from ..models import model as make_model
+
+    spec = chan.get("model_spec")
+    if isinstance(spec, dict):
+        return make_model(spec)
+    name = fit["model"]
+    if isinstance(name, dict):
+        return make_model(name, **(chan.get("params") or {}))
+    return make_model(str(name), **(chan.get("params") or {}))
+
+
+def fitted_models(fit: str | os.PathLike) -> dict[str, Model]:
+    """``{channel: fitted model}`` of a saved fit (``fit.json`` or its folder)."""
+    content, _ = read_fit_json(fit)
+    return {str(c["channel"]): channel_model(content, c) for c in content["channels"]}

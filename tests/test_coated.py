@@ -767,3 +767,154 @@ def test_pure_python_mode_agrees():
     np.testing.assert_allclose(pure[-1][0], rb.diffuse.oren_nayar(ti, tr, ph, 0.3), rtol=1e-13)
     assert pure[-1][1] == pytest.approx(rb.fresnel.diffuse_reflectance(1.5, internal=True),
                                         rel=1e-14)
+
+
+# ------------------------------------------------------------------------------------------
+# interface="rough": the substrate under the rough interface (Mitsuba 3's roughplastic);
+# checked against Mitsuba itself in tests/test_export_mitsuba.py
+# ------------------------------------------------------------------------------------------
+def rough_substrate_numpy(ti, tr, p, distribution):
+    """``rho/pi T(cos theta_i) T(cos theta_r) / (n^2 (1 - rho F_int))`` with the tables of
+    ``rb.diffuse.rough_interface`` interpolated by ``np.interp`` on the cell positions k/63
+    (Mitsuba's ``lerp_gather`` works on ``63 cos theta``, not on the clamped first node)."""
+    t, f_int = rb.diffuse.rough_interface(p["alpha"], p["n"], distribution)
+    nodes = np.arange(64) / 63.0
+    t_i, t_r = np.interp(np.cos(ti), nodes, t), np.interp(np.cos(tr), nodes, t)
+    return p["rho"] / np.pi * t_i * t_r / (p["n"] ** 2 * (1 - p["rho"] * f_int))
+
+
+@pytest.mark.parametrize("distribution, lobes, diffuse, shadow_diffuse", [
+    ("trowbridge-reitz", 1, "lambertian", False), ("beckmann", 2, "lambertian", False),
+    ("trowbridge-reitz", 3, "oren-nayar", True)])
+def test_rough_interface_is_the_formula(distribution, lobes, diffuse, shadow_diffuse):
+    rng = np.random.default_rng(31)
+    p = _random_params(rng, lobes, diffuse)
+    m = rb.model("coated", distribution=distribution, lobes=lobes, diffuse=diffuse,
+                 shadow_diffuse=shadow_diffuse, interface="rough", **p)
+    ti, tr, ph = _geometry(4000, 32)
+    for pol in (None, "s"):
+        lobes_only = coated_numpy(ti, tr, ph, {**p, "rho": 0.0}, distribution=distribution,
+                                  lobes=lobes, polarization=pol)
+        sub = rough_substrate_numpy(ti, tr, p, distribution)  # unpolarized
+        if diffuse == "oren-nayar":
+            sub = sub * on_eq30(ti, tr, ph, np.pi, p["sigma"])
+        if shadow_diffuse:
+            sub = sub * rb.shadowing.smith(ti, tr, p["alpha"], distribution, "smith-separable")
+        np.testing.assert_allclose(m.brdf(ti, tr, ph, pol), lobes_only + sub, rtol=1e-11,
+                                   atol=1e-300)
+
+
+def test_rough_interface_option():
+    m = rb.model("coated", interface="rough", shadow_diffuse=False)
+    assert m.options["interface"] == "rough"
+    smooth = m.with_params(interface="smooth")
+    assert "interface" not in smooth.options  # the default is not listed (older files read)
+    default = rb.model("coated", shadow_diffuse=False)
+    ti, tr, ph = _geometry(500, 33)
+    np.testing.assert_array_equal(smooth.brdf(ti, tr, ph), default.brdf(ti, tr, ph))
+    assert not np.allclose(m.brdf(ti, tr, ph), default.brdf(ti, tr, ph))
+    # rho = 0: no substrate, the interface does not matter
+    np.testing.assert_array_equal(m.with_params(rho=0.0).brdf(ti, tr, ph),
+                                  default.with_params(rho=0.0).brdf(ti, tr, ph))
+    with pytest.raises(ValueError, match="interface must be 'smooth' or 'rough'"):
+        rb.model("coated", interface="bumpy")
+    assert rb.model("coated", interface="ROUGH").options["interface"] == "rough"
+
+
+def test_rough_interface_reciprocal_and_symmetric():
+    m = rb.model("coated", interface="rough", shadow_diffuse=False, alpha=0.4, rho=0.9, n=1.7)
+    ti, tr, ph = _geometry(2000, 34)
+    np.testing.assert_allclose(m.brdf(ti, tr, ph), m.brdf(tr, ti, ph), rtol=1e-12)
+    np.testing.assert_array_equal(m.brdf(ti, tr, ph), m.brdf(ti, tr, -ph))
+
+
+def test_rough_tables_approach_the_smooth_interface():
+    # a nearly smooth interface transmits 1 - R(theta) (away from grazing), and its internal
+    # reflectance is Mitsuba's 64-node mean of the smooth internal Fresnel reflectance
+    t, f_int = rb.diffuse.rough_interface(0.005, 1.5)
+    mu = np.maximum(1e-6, np.linspace(0, 1, 64))
+    ok = mu > 0.2
+    np.testing.assert_allclose(t[ok], 1 - rb.fresnel.reflectance(mu[ok], 1.5), rtol=2e-3)
+    smooth = 2 * np.mean(rb.fresnel.reflectance(mu, 1 / 1.5) * mu)
+    assert f_int == pytest.approx(smooth, rel=2e-3)
+
+
+@pytest.mark.parametrize("mu, alpha", [(0.5, 0.3), (0.9, 0.6)])
+def test_rough_transmittance_is_the_lobe_integral(mu, alpha):
+    """``T(mu) = ∫ (1 - F(wi.m)) G1(wi) G1(wt) D(m) (wi.m)/cos(theta_i) dω_m`` (GGX) by an
+    adaptive quadrature written here; Mitsuba's 32 x 32 rule, which the table reproduces,
+    is ~2e-4 above it (the reason the table is not computed more accurately)."""
+    from scipy import integrate
+
+    n = 1.5
+    wi = np.array([math.sqrt(1 - mu * mu), 0.0, mu])
+
+    def g1(c):
+        return 2 / (1 + math.sqrt(1 + alpha ** 2 * (1 - c * c) / (c * c)))
+
+    def integrand(phm, thm):
+        m = np.array([math.sin(thm) * math.cos(phm), math.sin(thm) * math.sin(phm),
+                      math.cos(thm)])
+        c = float(wi @ m)
+        if c <= 0:
+            return 0.0
+        ct = math.sqrt(1 - (1 - c * c) / n ** 2)
+        wt = -wi / n + (c / n - ct) * m
+        d = float(rb.distributions.trowbridge_reitz(m[2], alpha))
+        f = float(rb.fresnel.reflectance(c, n))
+        return (1 - f) * g1(mu) * g1(abs(wt[2])) * d * c / mu * math.sin(thm)
+
+    exact, _ = integrate.dblquad(integrand, 0, HALF_PI, 0, 2 * math.pi, epsabs=1e-10,
+                                 epsrel=1e-9)
+    t, _ = rb.diffuse.rough_interface(alpha, n)
+    k = int(round(mu * 63))
+    assert mu == pytest.approx(k / 63, abs=0.01)
+    t_mu = np.interp(mu, np.arange(64) / 63, t)
+    assert t_mu == pytest.approx(exact, rel=6e-4)
+
+
+def test_erfinv_of_the_beckmann_sampling():
+    from scipy.special import erfinv
+
+    from roughbrdf.diffuse import _erfinv
+
+    y = np.concatenate([np.linspace(-0.999999999, 0.999999999, 4001),
+                        [1e-12, -0.5, 0.5, 1 - 1e-15, -1 + 1e-14, 1 - 2 ** -53]])
+    got = np.array([_erfinv(v) for v in y])
+    np.testing.assert_allclose(got, erfinv(y), rtol=1e-14)
+    assert _erfinv(1.0) == math.inf and _erfinv(-1.0) == -math.inf
+
+
+def test_rough_interface_arguments():
+    with pytest.raises(ValueError, match="distribution"):
+        rb.diffuse.rough_interface(0.3, 1.5, "gaussian-angle")
+    with pytest.raises(ValueError, match="alpha"):
+        rb.diffuse.rough_interface(0.0, 1.5)
+    with pytest.raises(ValueError, match="n must be"):
+        rb.diffuse.rough_interface(0.3, 1.0)
+    with pytest.raises(ValueError, match="g1"):
+        rb.diffuse.rough_interface(0.3, 1.5, g1="approximate")
+    t, f_int = rb.diffuse.rough_interface(0.3, 1.5, "beckmann", g1="mitsuba")
+    t2, f_int2 = rb.diffuse.rough_interface(0.3, 1.5, "beckmann")
+    assert t.shape == (64,) and 0 < f_int < 1 and f_int != f_int2  # the G1 differs
+
+
+def test_rough_interface_pure_python_mode_agrees():
+    code = textwrap.dedent("""
+        import json, numpy as np, numba, roughbrdf as rb
+        assert numba.config.DISABLE_JIT
+        m = rb.model("coated", alpha=0.3, rho=0.7, shadow_diffuse=False, interface="rough")
+        ti = np.array([0.0, 0.3, 1.2, 1.5]); tr = np.array([0.0, 0.4, 1.2, 1.5707963267948966])
+        ph = np.array([0.0, 1.0, 3.141592653589793, -2.0])
+        print(json.dumps([m.brdf(ti, tr, ph).tolist(), m.bridf(ti, tr, ph, "p").tolist()]))
+    """)
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
+    res = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                         timeout=300, check=True)
+    brdf, bridf = json.loads(res.stdout.strip().splitlines()[-1])
+    m = rb.model("coated", alpha=0.3, rho=0.7, shadow_diffuse=False, interface="rough")
+    ti = np.array([0.0, 0.3, 1.2, 1.5])
+    tr = np.array([0.0, 0.4, 1.2, HALF_PI])
+    ph = np.array([0.0, 1.0, math.pi, -2.0])
+    np.testing.assert_allclose(brdf, m.brdf(ti, tr, ph), rtol=1e-13)
+    np.testing.assert_allclose(bridf, m.bridf(ti, tr, ph, "p"), rtol=1e-13)

@@ -16,12 +16,20 @@ Composed from the library's parts (``docs/models.md`` §10.3), nothing re-derive
   parameter ``sigma``), and, with ``shadow_diffuse=True``, masked and shadowed by the first
   lobe's Smith ``G(theta_i, theta_r)`` (without the half vector: the light leaving the
   substrate crosses the same rough interface).
+* ``interface="rough"`` (default ``"smooth"``): the smooth factors ``1 - R(theta_i)``,
+  ``1 - R(theta_r)`` and ``F_dr,int`` become the first lobe's rough-interface transmittance
+  table ``T(theta_i) T(theta_r)`` and internal reflectance ``F_int``
+  (:func:`roughbrdf.diffuse.coated_diffuse_rough`, :func:`roughbrdf.diffuse.rough_interface`),
+  computed exactly as Mitsuba 3's ``roughplastic`` computes them; the substrate term is then
+  unpolarized (the tables are). One lobe, ``shadowing="smith-separable"``,
+  ``shadow_diffuse=False`` and ``interface="rough"`` is ``roughplastic`` itself (GGX to float32
+  rounding; :mod:`roughbrdf.export.mitsuba`).
 
 Why a named model and not a sum with tied parameters: the lobes and the substrate share ``n``
 (the specular ``F`` and the transmission ``1 - R`` are the same interface) and the diffuse
 shadowing uses the first lobe's ``alpha``; a named model states those ties once, keeps the
 parameter count honest for AIC/BIC, and maps one to one onto Mitsuba's ``roughplastic`` (one
-lobe, ``shadowing="smith-separable"``).
+lobe, ``shadowing="smith-separable"``, ``shadow_diffuse=False``, ``interface="rough"``).
 """
 
 from __future__ import annotations
@@ -33,7 +41,13 @@ from numba import prange
 from .. import distributions as dist
 from .. import shadowing as shd
 from .._kernels import at, driver, jit, sincos
-from ..diffuse import coated_diffuse, oren_nayar_factor
+from ..diffuse import (
+    ROUGH_TABLE_SIZE,
+    coated_diffuse,
+    coated_diffuse_rough,
+    oren_nayar_factor,
+    rough_interface,
+)
 from ..fresnel import diffuse_reflectance, fresnel_polarized_xy
 from ..geometry import half_vector, tr75_eta_xy
 from .base import Model, register
@@ -41,9 +55,15 @@ from .parameters import Parameter, nonnegative, positive, reflectance
 
 #: ``diffuse`` option -> code in the packed parameters
 DIFFUSE = {"lambertian": 0, "oren-nayar": 1}
+#: ``interface`` option -> code in the packed parameters
+INTERFACE = {"smooth": 0, "rough": 1}
 #: most specular lobes (the packed parameters have a slot for each; an unused lobe has ks = 0)
 MAX_LOBES = 3
 _LOBE0 = 7  # index of the first lobe's (alpha, ks, norm) in the packed parameters
+# packed after the distribution code (16): the interface code (17), the rough interface's
+# internal reflectance (18) and its transmittance table (19 to 82; zeros for "smooth")
+_INTERFACE = 17
+_TABLE0 = 19
 
 
 @jit(inline=True)
@@ -55,7 +75,7 @@ def _lobe(dcode, scode, a, ks, norm, hz, ci, cr):
 
 
 @jit(inline=True)
-def _coated_eval(ti, tr, phi, gamma, p, flag, dcode):
+def _coated_eval(ti, tr, phi, gamma, p, flag, dcode, rough):
     n, rho, sigma2, scode, dmode, dshadow, fdr_int = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
     scode = int(scode)
     hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
@@ -64,7 +84,10 @@ def _coated_eval(ti, tr, phi, gamma, p, flag, dcode):
     spec = _lobe(dcode, scode, p[7], p[8], p[9], hz, ci, cr)
     spec += _lobe(dcode, scode, p[10], p[11], p[12], hz, ci, cr)
     spec += _lobe(dcode, scode, p[13], p[14], p[15], hz, ci, cr)
-    diff = coated_diffuse(ci, cr, n, gamma, rho, fdr_int)
+    if rough:  # a literal in each driver loop: the other interface's code compiles away
+        diff = coated_diffuse_rough(ci, cr, n, rho, p[18], p, _TABLE0)
+    else:
+        diff = coated_diffuse(ci, cr, n, gamma, rho, fdr_int)
     if dmode > 0.0:
         sr, cp = sincos(tr)[0], sincos(phi)[1]
         diff *= oren_nayar_factor(ci, cr, si, sr, cp, sigma2)
@@ -77,14 +100,26 @@ def _coated_eval(ti, tr, phi, gamma, p, flag, dcode):
 @driver
 def _coated_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
     # module-level loop: cached on disk (roughbrdf._kernels.compile.driver); the distribution
-    # a literal in each loop (Trowbridge-Reitz/GGX or Beckmann: the two with a Smith Lambda)
+    # (Trowbridge-Reitz/GGX or Beckmann: the two with a Smith Lambda) and the interface
+    # literals in each loop, so that the smooth loops stay free of the table look-up
+    rough = p[_INTERFACE] > 0.0
     if int(p[16]) == dist.TR:
+        if rough:
+            for i in prange(out.size):
+                out[i] = _coated_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, flag, dist.TR,
+                                      True)
+        else:
+            for i in prange(out.size):
+                out[i] = _coated_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, flag, dist.TR,
+                                      False)
+    elif rough:
         for i in prange(out.size):
-            out[i] = _coated_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, flag, dist.TR)
+            out[i] = _coated_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, flag,
+                                  dist.BECKMANN, True)
     else:
         for i in prange(out.size):
             out[i] = _coated_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, flag,
-                                  dist.BECKMANN)
+                                  dist.BECKMANN, False)
 
 
 def _lobe_parameters(j: int) -> tuple[Parameter, Parameter]:
@@ -103,8 +138,11 @@ class Coated(Model):
     Options: ``distribution`` (``"trowbridge-reitz"``/GGX or ``"beckmann"``), ``shadowing``
     (``"smith-separable"`` or ``"smith-height-correlated"``), ``lobes`` (1 to 3 specular lobes
     sharing ``n``), ``diffuse`` (``"lambertian"`` or ``"oren-nayar"``), ``shadow_diffuse``
-    (mask and shadow the substrate term by the first lobe's Smith G). Reciprocal.
-    ``docs/models.md`` §10.3; the module notes give the formula.
+    (mask and shadow the substrate term by the first lobe's Smith G), ``interface``
+    (``"smooth"``: Fresnel transmission of a smooth interface into and out of the coating;
+    ``"rough"``: the first lobe's rough-interface transmittance, Mitsuba 3's ``roughplastic``;
+    listed in :attr:`options` only when ``"rough"``). Reciprocal. ``docs/models.md`` §10.3; the
+    module notes give the formula.
 
     Examples
     --------
@@ -115,6 +153,9 @@ class Coated(Model):
     >>> m0 = m.with_params(rho=1.0, ks=0.0, ks2=0.0, shadow_diffuse=False)
     >>> round(float(rb.albedo(m0, 0.0)), 3)      # rho = 1, no lobes: 1 - F(0), F(0) = 0.04
     0.96
+    >>> rough = rb.model("coated", alpha=0.3, rho=0.5, shadow_diffuse=False, interface="rough")
+    >>> round(rough.brdf(0.0, 0.0, 0.0), 5)     # roughplastic's value (Mitsuba 3)
+    0.11645
     """
 
     name = "coated"
@@ -122,7 +163,7 @@ class Coated(Model):
     short = "coat"
     reference = "Weidlich & Wilkie 2007; Walter et al. 2007; Oren & Nayar 1994"
     OPTIONS = {"distribution": "trowbridge-reitz", "shadowing": "smith-separable", "lobes": 1,
-               "diffuse": "lambertian", "shadow_diffuse": True}
+               "diffuse": "lambertian", "shadow_diffuse": True, "interface": "smooth"}
     _drive = _coated_drive
 
     def _check_options(self, options):
@@ -148,8 +189,17 @@ class Coated(Model):
             sd = sd.strip().lower() in ("true", "1")
         if not isinstance(sd, bool):
             raise ValueError(f"shadow_diffuse must be true or false, got {sd!r}")
-        return {"distribution": d.name, "shadowing": shd.canonical(s), "lobes": int(lobes),
-                "diffuse": diffuse, "shadow_diffuse": sd}
+        interface = str(options["interface"]).strip().lower()
+        if interface not in INTERFACE:
+            raise ValueError(f"interface must be 'smooth' or 'rough', "
+                             f"got {options['interface']!r}")
+        out = {"distribution": d.name, "shadowing": shd.canonical(s), "lobes": int(lobes),
+               "diffuse": diffuse, "shadow_diffuse": sd}
+        if interface == "rough":
+            # listed only when not the default: models, reprs and fit files of the smooth
+            # coating read as they did before the option existed
+            out["interface"] = interface
+        return out
 
     def _parameter_specs(self) -> tuple[Parameter, ...]:
         specs = [Parameter("n", 1.5, (1.05, 2.5), "1", "refractive index of the coating",
@@ -179,7 +229,12 @@ class Coated(Model):
             else:
                 a, ks = 1.0, 0.0  # unused slot: a valid width, switched off by ks = 0
             lobes += [a, ks, dist.normalization(d, a)]
+        if o.get("interface") == "rough":
+            table, f_int = rough_interface(v["alpha"], v["n"], o["distribution"])
+            rough = (1.0, f_int, *table)
+        else:
+            rough = (0.0, 0.0) + (0.0,) * ROUGH_TABLE_SIZE
         return (v["n"], v["rho"], v.get("sigma", 0.0) ** 2,
                 shd.get(o["shadowing"]).code, DIFFUSE[o["diffuse"]],
                 1.0 if o["shadow_diffuse"] else 0.0,
-                diffuse_reflectance(v["n"], internal=True), *lobes, d)
+                diffuse_reflectance(v["n"], internal=True), *lobes, d, *rough)

@@ -918,3 +918,11 @@ def test_rough_interface_pure_python_mode_agrees():
     ph = np.array([0.0, 1.0, math.pi, -2.0])
     np.testing.assert_allclose(brdf, m.brdf(ti, tr, ph), rtol=1e-13)
     np.testing.assert_allclose(bridf, m.bridf(ti, tr, ph, "p"), rtol=1e-13)
+
+
+def test_a_sum_takes_an_option_left_at_its_default_out_of_options():
+    # coated lists "interface" in .options only when it is "rough"; rb.model("a+b", ...) must
+    # still route it to the coated component (models.factory)
+    m = rb.model("coated+lambertian", interface="rough", shadow_diffuse=False)
+    assert m.components[0].options["interface"] == "rough"
+    assert "interface" not in rb.model("coated").options

@@ -62,7 +62,10 @@ def _sum_from_names(spec: str, names: list[str], params: dict[str, Any]) -> SumM
         if hit:
             per[hit[0]][key[len(total.prefixes[hit[0]]):]] = val
             continue
-        hit = [i for i, d in enumerate(defaults) if key in d.params or key in d.options]
+        # options by the class's declared OPTIONS: a model may leave an option at its
+        # default out of .options (coated "interface")
+        hit = [i for i, d in enumerate(defaults)
+               if key in d.params or key in d.options or key in type(d).OPTIONS]
         if len(hit) == 1:
             per[hit[0]][key] = val
         elif not hit:

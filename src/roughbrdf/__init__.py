@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING as _TYPE_CHECKING  # noqa: E402
 
 if _TYPE_CHECKING:  # for type checkers and IDEs; at run time the names load on first use
     from . import diffuse, distributions, fresnel, geometry, shadowing
+    from .export import export_mitsuba, export_to, export_zemax
     from .fitting import FitResult, compare, fit
     from .integrate import albedo, reciprocity_error
     from .io import read, write
@@ -40,6 +41,9 @@ __all__ = [
     "compare",
     "diffuse",
     "distributions",
+    "export_mitsuba",
+    "export_to",
+    "export_zemax",
     "fit",
     "FitResult",
     "fresnel",
@@ -60,6 +64,9 @@ _ATTRS = {
     "FitResult": "fitting",
     "fit": "fitting",
     "compare": "fitting",
+    "export_to": "export",
+    "export_mitsuba": "export",
+    "export_zemax": "export",
     "albedo": "integrate",
     "reciprocity_error": "integrate",
     "read": "io",
@@ -75,8 +82,9 @@ _ATTRS = {
 #: submodules reachable as attributes (``rb.geometry``) without importing them first: the public
 #: ones of ``__all__`` and those an eager ``import roughbrdf`` used to load as a side effect
 _SUBMODULES = frozenset({
-    "diffuse", "distributions", "fresnel", "geometry", "shadowing", "fitting", "integrate", "io",
-    "measurement", "models", "polarization", "quantity", "registry", "special",
+    "diffuse", "distributions", "export", "fresnel", "geometry", "shadowing", "fitting",
+    "integrate", "io", "measurement", "models", "polarization", "quantity", "registry",
+    "special",
 })
 
 

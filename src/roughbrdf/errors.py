@@ -79,7 +79,9 @@ class ArgumentError(ValueError):
                 f"{name} = {self.value!r}" + (f" {self.unit}" if self.unit else ""))
             head += ": "
         text = head + self.message
-        if self.fix is not _UNSET:
+        if self.fix is True and cli:  # a flag: "pass --fit-closest", not "... True"
+            text += f"; pass {name}"
+        elif self.fix is not _UNSET:
             text += f"; pass {name} {self.fix}" if cli else f"; pass {name}={self.fix!r}"
         return text
 

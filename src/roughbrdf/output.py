@@ -39,8 +39,8 @@ from typing import IO, Any
 
 from .interrupts import held_interrupts, raise_if_interrupted
 
-__all__ = ["atomic_write", "staged", "same_file", "ensure_folder", "ResultFolder",
-           "OverwriteRefused", "MANIFEST", "LOCK", "TMP_PREFIX"]
+__all__ = ["atomic_write", "staged", "same_file", "ensure_folder", "refuse_existing",
+           "ResultFolder", "OverwriteRefused", "MANIFEST", "LOCK", "TMP_PREFIX"]
 
 #: prefix of the temporary files (a leftover one, after a power cut, is recognizable)
 TMP_PREFIX = ".roughbrdf-tmp-"
@@ -205,6 +205,16 @@ def staged(path: str | os.PathLike, *, overwrite: bool = False, binary: bool = F
         if tmp is not None:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
+
+
+def refuse_existing(path: str | os.PathLike, overwrite: bool) -> None:
+    """Raise before any work what :func:`atomic_write` would raise at the end: an existing
+    ``path`` without ``overwrite`` (:class:`OverwriteRefused`), a folder where the file goes."""
+    target = Path(path)
+    if target.is_dir():
+        raise IsADirectoryError(f"{target} is a folder, not a file; give a file name")
+    if target.exists() and not overwrite:
+        raise OverwriteRefused(target, single=True)
 
 
 def _put(tmp: str, target: Path, overwrite: bool) -> None:

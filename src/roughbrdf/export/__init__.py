@@ -2,5 +2,166 @@
 
 One module per target: :mod:`~roughbrdf.export.zemax` (Zemax OpticStudio tabular BSDF, the
 model sampled on a grid relative to the specular direction) and :mod:`~roughbrdf.export.mitsuba`
-(Mitsuba 3 scene-description dicts and XML ``<bsdf>`` elements).
+(Mitsuba 3 scene-description dicts and XML ``<bsdf>`` elements). :func:`export` writes any of
+them to a file by the project's output rules (no file replaced unless ``overwrite=True``; each
+written atomically), which is what ``roughbrdf export`` runs. At the top level:
+``rb.export_to`` (:func:`export`), ``rb.export_zemax`` (:func:`~roughbrdf.export.zemax.to_zemax`)
+and ``rb.export_mitsuba`` (:func:`~roughbrdf.export.mitsuba.export_mitsuba`). (``rb.export`` is
+this package.)
 """
+
+from __future__ import annotations
+
+import json
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ..errors import ArgumentError
+
+__all__ = ["TARGETS", "ExportResult", "export", "export_mitsuba", "export_to", "export_zemax",
+           "target_name"]
+
+#: ``to=`` -> what is written
+TARGETS = {
+    "zemax": "Zemax OpticStudio tabular BSDF (.bsdf), one file per channel",
+    "mitsuba": "Mitsuba 3 scene-description dict as JSON (mitsuba.load_dict(json.load(f)))",
+    "mitsuba-xml": "Mitsuba 3 XML <bsdf> element (a document mitsuba.load_string loads)",
+}
+
+
+@dataclass
+class ExportResult:
+    """What :func:`export` wrote.
+
+    Attributes
+    ----------
+    target : str
+    paths : list of pathlib.Path
+        The files written.
+    report : str
+        How the export went: the Zemax files' TIS and table integrals, or how each Mitsuba
+        term was mapped and how far Mitsuba's values are from the model's.
+    detail : object
+        The target's own record (:class:`~roughbrdf.export.zemax.ZemaxExport` or
+        :class:`~roughbrdf.export.mitsuba.MitsubaExport`).
+    """
+
+    target: str
+    paths: list[Path]
+    report: str
+    detail: Any = field(repr=False, default=None)
+
+
+def target_name(to: str) -> str:
+    """The canonical target of ``to`` (aliases: opticstudio, bsdf, xml, json...); an
+    :class:`~roughbrdf.errors.ArgumentError` naming ``to`` otherwise."""
+    key = str(to).strip().lower().replace("_", "-")
+    key = {"opticstudio": "zemax", "bsdf": "zemax", "xml": "mitsuba-xml",
+           "mitsuba-dict": "mitsuba", "json": "mitsuba"}.get(key, key)
+    if key not in TARGETS:
+        raise ArgumentError("to", f"unknown target; choose one of {', '.join(TARGETS)}",
+                            value=to)
+    return key
+
+
+def export(source: Any, out: str | os.PathLike, *, to: str, overwrite: bool = False,
+           channel: int | str | None = None, **options: Any) -> ExportResult:
+    """Write a model or a fit for another tool.
+
+    Parameters
+    ----------
+    source : Model, FitResult or mapping
+        A model (``rb.model``), a fit (``rb.fit``), or ``{channel: model}``
+        (:func:`roughbrdf.fitting.result.fitted_models` reads one from a fit's folder).
+    out : str or path-like
+        The file (``.bsdf``, ``.json`` or ``.xml`` added without a suffix). A fit whose
+        channels are not one BSDF gives one file per channel, ``<stem>_<channel><suffix>``
+        beside it (Mitsuba: where the channels differ in more than colours).
+    to : {"zemax", "mitsuba", "mitsuba-xml"}
+        The target (:data:`TARGETS`).
+    overwrite : bool
+        Replace existing files (default: refuse, before writing anything).
+    channel : int or str, optional
+        One channel of a fit.
+    **options
+        The target's own: Zemax ``angles_of_incidence``, ``radial``, ``azimuth`` (radians),
+        ``symmetry``, ``polarization`` (:func:`~roughbrdf.export.zemax.to_zemax`); Mitsuba
+        ``rgb``, ``fit``, ``theta_max`` (:func:`~roughbrdf.export.mitsuba.export_mitsuba`).
+
+    Returns
+    -------
+    ExportResult
+
+    Examples
+    --------
+    >>> import roughbrdf as rb, tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> res = rb.export_to(rb.model("lambertian", rho=0.25), folder / "paint.xml",
+    ...                    to="mitsuba-xml")
+    >>> print(res.paths[0].read_text().strip())
+    <bsdf type="diffuse" version="3.0.0">
+      <float name="reflectance" value="0.25" />
+    </bsdf>
+    >>> rb.export_to(rb.model("lambertian"), folder / "paint.xml", to="mitsuba-xml")
+    Traceback (most recent call last):
+    ...
+    roughbrdf.output.OverwriteRefused: ...paint.xml exists; not overwriting it (pass overwrite=True)
+    """
+    target = target_name(to)
+    if target == "zemax":
+        from .zemax import to_zemax
+
+        tables = to_zemax(source, out, channel=channel, overwrite=overwrite, **options)
+        return ExportResult(target, list(tables.paths), tables.text(), tables)
+    from .mitsuba import export_mitsuba
+
+    done = export_mitsuba(source, channel=channel, **options)
+    suffix = ".json" if target == "mitsuba" else ".xml"
+    base = Path(out) if Path(out).suffix else Path(out).with_suffix(suffix)
+    if done.rule == "per-channel":  # one BSDF per channel: one file each, each loadable
+        files = {base.with_name(f"{base.stem}_{_safe(label)}{base.suffix}"): bsdf
+                 for label, bsdf in done.bsdf.items()}
+    else:
+        files = {base: done.bsdf}
+    return ExportResult(target, _write_mitsuba(files, target, overwrite), done.summary(), done)
+
+
+def _safe(label: str) -> str:
+    return re.sub(r"[^A-Za-z0-9.+-]+", "_", str(label)).strip("._") or "channel"
+
+
+def _write_mitsuba(files: dict[Path, dict[str, Any]], target: str, overwrite: bool
+                   ) -> list[Path]:
+    """Each BSDF as a Mitsuba document: the dict as JSON (``mitsuba.load_dict(json.load(f))``)
+    or an XML ``<bsdf version="3.0.0">`` (``mitsuba.load_file``/``load_string``); every file
+    checked before the first is written, each written atomically."""
+    from ..output import atomic_write, refuse_existing
+    from .mitsuba import xml_text
+
+    for path in files:
+        refuse_existing(path, overwrite)
+    for path, bsdf in files.items():
+        text = (json.dumps(bsdf, indent=2, allow_nan=False) if target == "mitsuba"
+                else xml_text(bsdf, version="3.0.0"))
+        atomic_write(path, text + "\n", overwrite=overwrite)
+    return list(files)
+
+#: ``rb.export_to``: ``rb.export`` is this package
+export_to = export
+
+
+def export_zemax(*args: Any, **kwargs: Any) -> Any:
+    """:func:`roughbrdf.export.zemax.to_zemax` (``rb.export_zemax``)."""
+    from .zemax import to_zemax
+
+    return to_zemax(*args, **kwargs)
+
+
+def export_mitsuba(*args: Any, **kwargs: Any) -> Any:
+    """:func:`roughbrdf.export.mitsuba.export_mitsuba` (``rb.export_mitsuba``)."""
+    from .mitsuba import export_mitsuba as _export
+
+    return _export(*args, **kwargs)

@@ -83,7 +83,7 @@ from __future__ import annotations
 import math
 import re
 import xml.etree.ElementTree as ET
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Any
@@ -99,7 +99,7 @@ from ..models.base import Model, components
 from ..quantity import Quantity
 
 __all__ = ["EXACT", "FLOOR", "Deviation", "MitsubaExport", "TermExport", "deviation_grid",
-           "export_mitsuba", "mitsuba_values", "to_mitsuba", "to_mitsuba_xml"]
+           "export_mitsuba", "mitsuba_values", "to_mitsuba", "to_mitsuba_xml", "xml_text"]
 
 #: largest deviation from the model (on :func:`deviation_grid`) of a mapping called "exact":
 #: half of the 1e-4 the tests check with Mitsuba, the other half for its float32 arithmetic
@@ -222,8 +222,8 @@ class MitsubaExport:
         :func:`mitsuba.load_string` loads as the BSDF.
         """
         if self.rule != "per-channel":
-            return _xml_text(self.bsdf, id, version)
-        return "\n".join(_xml_text(b, f"{id}-{label}" if id else label, version)
+            return xml_text(self.bsdf, id, version)
+        return "\n".join(xml_text(b, f"{id}-{label}" if id else label, version)
                          for label, b in self.bsdf.items())
 
     def summary(self) -> str:
@@ -649,9 +649,10 @@ def _export_term(m: Model, label: str, fit: bool, grid: tuple[np.ndarray, ...]
     reasons = _why_not(m)
     where = f"model {m.name!r}" + (f" (term {label!r})" if label != m.name else "")
     if reasons and not fit:
-        raise ValueError(f"{where} has no Mitsuba 3 counterpart: {'; '.join(reasons)}. "
-                         f"Pass fit=True to export the closest Mitsuba model fitted to its "
-                         f"values (the export then reports the deviation)")
+        raise ArgumentError("fit", f"{where} has no Mitsuba 3 counterpart: "
+                            f"{'; '.join(reasons)}. The closest Mitsuba model fitted to its "
+                            f"values can be exported instead (the export then reports the "
+                            f"deviation)", fix=True)
     values = np.asarray(m.brdf(*grid), dtype=float)
     stand_in = None
     if reasons or (fit and m.name == "trowbridge-reitz-1975"):
@@ -700,6 +701,20 @@ def _models_of(source: Any, channel: Any) -> tuple[dict[str, Model], str]:
             raise ArgumentError("channel", "applies to a fit with channels, not to a model",
                                 value=channel)
         return {"": source}, "model"
+    if isinstance(source, Mapping) and source and all(isinstance(m, Model)
+                                                      for m in source.values()):
+        # {channel: model}, e.g. roughbrdf.fitting.result.fitted_models(fit folder)
+        models = {str(k): m for k, m in source.items()}
+        if channel is None:
+            return models, ("channel" if len(models) == 1 else "multi")
+        labels = list(models)
+        key = str(channel) if str(channel) in models else (
+            labels[int(channel)] if str(channel).lstrip("-").isdigit()
+            and -len(labels) <= int(channel) < len(labels) else None)
+        if key is None:
+            raise ArgumentError("channel", f"no such channel; the fit has {labels}",
+                                value=channel)
+        return {key: models[key]}, "channel"
     if isinstance(getattr(source, "model", None), Model) and hasattr(source, "channel"):
         if channel is not None:  # one channel's result (res[label])
             raise ArgumentError("channel", "applies to a whole fit, not to one channel's "
@@ -760,8 +775,9 @@ def export_mitsuba(source: Any, *, channel: int | str | None = None, rgb: Any = 
 
     Parameters
     ----------
-    source : Model or FitResult
-        A model (sums allowed) or a fit (its fitted models).
+    source : Model, FitResult or mapping
+        A model (sums allowed), a fit (its fitted models), or ``{channel: model}`` (e.g.
+        :func:`roughbrdf.fitting.result.fitted_models` of a saved fit).
     channel : int or str, optional
         One channel of a fit (label or position).
     rgb : None, False or (red, green, blue)
@@ -847,7 +863,7 @@ def to_mitsuba(source: Any, *, channel: int | str | None = None, rgb: Any = None
     >>> to_mitsuba(rb.model("microfacet", shadowing="smith-height-correlated"))
     Traceback (most recent call last):
     ...
-    ValueError: model 'microfacet' has no Mitsuba 3 counterpart: shadowing ... fit=True ...
+    roughbrdf.errors.ArgumentError: model 'microfacet' has no Mitsuba 3 counterpart: ...fit=True
     """
     return export_mitsuba(source, channel=channel, rgb=rgb, fit=fit, theta_max=theta_max).bsdf
 
@@ -907,7 +923,10 @@ def _xml_element(bsdf: dict[str, Any], name: str | None = None) -> ET.Element:
     return el
 
 
-def _xml_text(bsdf: dict[str, Any], id: str | None, version: str | None) -> str:  # noqa: A002
+def xml_text(bsdf: dict[str, Any], id: str | None = None,  # noqa: A002
+             version: str | None = None) -> str:
+    """One BSDF dict as an XML ``<bsdf>`` element; ``version="3.0.0"`` makes it a document
+    Mitsuba loads on its own (``mitsuba.load_string``)."""
     el = _xml_element(bsdf)
     if version is not None:
         el.set("version", str(version))

@@ -19,7 +19,8 @@ def available() -> list[str]:
 def model(name: str | dict, **params: Any) -> Model:
     """Build a registered model by name (case-insensitive; aliases accepted), or a sum.
 
-    ``name`` may be ``"NAME+NAME+..."``: the sum of the named models, with each setting given
+    ``name`` may be a spec with settings, ``"coated(lobes=2)"`` (:func:`from_spec`), or
+    ``"NAME+NAME+..."``: the sum of the named models, with each setting given
     either by its prefixed name (``tr75_e``, as :attr:`Model.params` of the sum shows it) or by
     a plain parameter or option name that belongs to exactly one component
     (``distribution="beckmann"``). A dict from :meth:`Model.to_dict` rebuilds that model.
@@ -36,6 +37,9 @@ def model(name: str | dict, **params: Any) -> Model:
     """
     if isinstance(name, dict):  # from to_dict()
         return _from_dict(name, params)
+    if "(" in str(name):  # a spec with settings, "coated(lobes=2)" (from_spec)
+        built = from_spec(str(name))
+        return built.with_params(**params) if params else built
     names = [s.strip() for s in str(name).split("+")]
     if not all(names):
         raise ValueError(f"bad model {name!r}: expected NAME or NAME+NAME")

@@ -1,0 +1,129 @@
+"""``roughbrdf export (MODEL -p ... | --fit DIR) --to zemax|mitsuba|mitsuba-xml --out PATH``.
+
+Writes a model, or the fitted models of a saved fit (``fit.json``), for another tool
+(:func:`roughbrdf.export.export`, ``docs/export.md``): a Zemax OpticStudio tabular BSDF
+(``.bsdf``; a fit gives ``<stem>_<channel>.bsdf`` per channel; grid options ``--incidences``,
+``--radial``, ``--azimuth`` in degrees, ``--symmetry``), a Mitsuba 3 scene-description dict as
+JSON, or a Mitsuba 3 XML ``<bsdf>``. What does not map onto Mitsuba is refused with the reason,
+or with ``--fit-closest`` exported as the closest Mitsuba model fitted to it, with the deviation
+printed. Nothing is replaced without ``--force``; every file is written atomically.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from .common import degree_range, handled, parse_params
+
+#: the library's argument names -> this verb's options (errors name the options)
+OPTIONS = {"to": "--to", "channel": "--channel", "overwrite": "--force", "fit": "--fit-closest",
+           "angles_of_incidence": "--incidences", "radial": "--radial",
+           "azimuth": "--azimuth", "symmetry": "--symmetry", "rgb": "--rgb/--no-rgb",
+           "theta_max": "--theta-max", "out": "--out"}
+
+
+def _source(model: str | None, param: list[str] | None, fit_dir: str | None) -> Any:
+    """The model of MODEL and ``-p``, or the fitted models ``{channel: model}`` of ``--fit``."""
+    if (model is None) == (fit_dir is None):
+        raise ValueError("give a MODEL (with -p settings) or --fit DIR, not both or neither")
+    if fit_dir is not None:
+        if param:
+            raise ValueError("-p sets a MODEL's parameters; a fit's models are as fitted")
+        from ..fitting.result import fitted_models
+
+        return fitted_models(fit_dir)
+    from ..models import model as make_model
+
+    return make_model(str(model), **parse_params(param))
+
+
+def _zemax_options(incidences: str | None, radial: str | None, azimuth: str | None,
+                   symmetry: str | None) -> dict[str, Any]:
+    opts: dict[str, Any] = {}
+    for key, text, name in (("angles_of_incidence", incidences, "--incidences"),
+                            ("radial", radial, "--radial"), ("azimuth", azimuth, "--azimuth")):
+        if text is not None:
+            opts[key] = degree_range(text, name)
+    if symmetry is not None:
+        opts["symmetry"] = symmetry
+    return opts
+
+
+def run_export(model: str | None, param: list[str] | None, fit_dir: str | None, to: str,
+               out: str, *, channel: str | None, force: bool, grid: dict[str, Any],
+               rgb: bool | None, fit_closest: bool, theta_max: float | None) -> None:
+    """The work of ``roughbrdf export``: checked, written, reported."""
+    from ..export import export, target_name
+
+    target = target_name(to)
+    if target == "zemax":
+        if rgb is not None or fit_closest or theta_max is not None:
+            raise ValueError("--rgb/--no-rgb, --fit-closest and --theta-max apply to the "
+                             "Mitsuba targets")
+        options = grid
+    else:
+        if grid:
+            raise ValueError("--incidences, --radial, --azimuth and --symmetry apply to "
+                             "--to zemax")
+        options = {"fit": fit_closest}
+        if rgb is not None:
+            options["rgb"] = None if rgb else False
+        if theta_max is not None:
+            if not (math.isfinite(theta_max) and 0 < theta_max < 90):
+                raise ValueError(f"--theta-max must be in (0, 90) degrees, got {theta_max!r}")
+            options["theta_max"] = math.radians(theta_max)
+    source = _source(model, param, fit_dir)
+    chan: Any = channel
+    if channel is not None and channel.lstrip("-").isdigit() and isinstance(source, dict) \
+            and channel not in source:
+        chan = int(channel)
+    res = export(source, Path(out), to=target, overwrite=force, channel=chan, **options)
+    typer.echo(res.report)
+    typer.echo("wrote " + ", ".join(str(p) for p in res.paths))
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("export")
+    def export_cmd(
+        model: Annotated[str | None, typer.Argument(
+            help="model name or spec, e.g. coated(lobes=2) or microfacet+lambertian "
+                 "(or --fit DIR)")] = None,
+        to: str = typer.Option(..., "--to", help="zemax (.bsdf), mitsuba (dict as JSON) or "
+                                                 "mitsuba-xml (<bsdf>)"),
+        out: str = typer.Option(..., "--out", "-o", help="the file (Zemax: one per channel "
+                                                          "of a fit, <stem>_<channel>.bsdf)"),
+        param: Annotated[list[str] | None, typer.Option(
+            "-p", "--param", help="a MODEL's parameter or option, name=value (repeatable)")] = None,
+        fit_dir: str = typer.Option(None, "--fit", metavar="DIR",
+                                    help="export the fitted models of a saved fit (fit.json)"),
+        channel: str = typer.Option(None, "--channel", "-c",
+                                    help="one channel of the fit (label or index)"),
+        incidences: str = typer.Option(None, "--incidences", metavar="DEG|START:STOP:STEP",
+                                       help="Zemax: angles of incidence (default 0:80:10)"),
+        radial: str = typer.Option(None, "--radial", metavar="START:STOP:STEP",
+                                   help="Zemax: scatter angles from the specular direction "
+                                        "(default: graded, dense near specular)"),
+        azimuth: str = typer.Option(None, "--azimuth", metavar="START:STOP:STEP",
+                                    help="Zemax: azimuths about the specular direction"),
+        symmetry: str = typer.Option(None, "--symmetry",
+                                     help="Zemax: PlaneSymmetrical (default) or Asymmetrical"),
+        rgb: bool = typer.Option(None, "--rgb/--no-rgb",
+                                 help="Mitsuba: one RGB BSDF where the channels differ only in "
+                                      "colours (default where possible), or one per channel"),
+        fit_closest: bool = typer.Option(False, "--fit-closest",
+                                         help="Mitsuba: export what does not map as the "
+                                              "closest Mitsuba model, fitted (deviation shown)"),
+        theta_max: float = typer.Option(None, "--theta-max", metavar="DEG",
+                                        help="Mitsuba: largest angle of the deviation grid "
+                                             "(default 80)"),
+        force: bool = typer.Option(False, "--force", help="replace existing files"),
+    ) -> None:
+        """Export a model or a fit to Zemax OpticStudio (.bsdf) or Mitsuba 3 (dict, XML)."""
+        with handled(OPTIONS):
+            run_export(model, param, fit_dir, to, out, channel=channel, force=force,
+                       grid=_zemax_options(incidences, radial, azimuth, symmetry), rgb=rgb,
+                       fit_closest=fit_closest, theta_max=theta_max)

@@ -27,6 +27,15 @@ Needs ``../shared/data`` (or ``ROUGHBRDF_SHARED_DATA``); prints a note and retur
    chosen. With ``--docs`` the fit plots are saved as ``docs/img/rb08_<file>.png``: the
    panels of ``FitResult.plot`` (drawn through the fit's aperture) and a zoom on the retro peak
    with the model at each direction and through the aperture.
+5. **RB08 on one Mini-Diff channel** (``--rb08-paints`` runs only this): the 14-parameter fit
+   of channel 465 nm of each paint (relative loss, ``rb.fit`` defaults) with the literal and the
+   numeric normalization: time, cost (chi-square) and model evaluations, against the fit with
+   the bulk and retro terms switched off (``bulk = retro = 0`` fixed, and ``rho_r, w_r, n_r``,
+   which then do nothing); and where one evaluation's time goes (the tabulated kernel that
+   runs real ``n``, the general kernel it replaced, the numeric N of one lobe at the
+   channel's four incidences). Until 2026-12 the numeric-N fit of C2_Black took ~40-77 s
+   (the 2-D lobe quadrature, ~3 ms per incidence and parameter change) and the literal fit of
+   C8_Silver ~40-60 s (the general kernel, 1.6 ms per evaluation).
 """
 
 from __future__ import annotations
@@ -380,12 +389,74 @@ def save_rb08_plot(name: str, res) -> None:
     print(f"\nsaved {out.relative_to(HERE.parent)}\n")
 
 
+#: the fit with RB08's bulk and retro terms switched off: these fixed (bulk = retro = 0)
+RB08_OFF = ("bulk", "retro", "rho_r", "w_r", "n_r")
+RB08_CHANNEL = 0
+
+
+def rb08_paint_fit(meas, normalization: str, off: bool = False):
+    """``rb.fit`` of RB08 (defaults) to channel :data:`RB08_CHANNEL`; ``off``: bulk and retro
+    switched off. Returns (time in s, ChannelFit)."""
+    model = rb.model("renhorn-boreman-2008", normalization=normalization,
+                     **({"bulk": 0.0, "retro": 0.0} if off else {}))
+    t = time.perf_counter()
+    res = rb.fit(model, meas, channel=RB08_CHANNEL, fix=RB08_OFF if off else (), progress=False)
+    return time.perf_counter() - t, res.channels[0]
+
+
+def rb08_evaluation_split(meas) -> str:
+    """Time of one model evaluation on the channel's geometry (best of 20), by part."""
+    from roughbrdf.models import renhorn_boreman as rbm
+
+    keep = meas.theta_r <= math.radians(75.0) + 1e-9  # the fitted samples (no extrapolation)
+    m = rb.model("renhorn-boreman-2008", n=4.37, n_r=2.61, w_a=0.3)  # real n: not integer
+    g = m.prepare(meas.theta_i[keep], meas.theta_r[keep], meas.phi[keep])
+    general = m.with_general_kernel()
+    ti = np.unique(meas.theta_i)
+    t_tab, _ = best_time(lambda: m.evaluate_prepared(g), repeat=20)
+    t_gen, _ = best_time(lambda: general.evaluate_prepared(g), repeat=20)
+    t_num, _ = best_time(lambda: rbm.lobe_integral(ti, 0.31, 0.87, 4.37), repeat=20)
+    return (f"one evaluation on {int(keep.sum())} geometries: tabulated kernel (real n, V once "
+            f"per distinct angle) {1e3 * t_tab:.2f} ms, general kernel (V per sample, which ran "
+            f"real n until 2026-12) {1e3 * t_gen:.2f} ms; numeric N of one lobe at the "
+            f"{ti.size} incidences {1e3 * t_num:.3f} ms (the 2-D quadrature took ~12 ms)")
+
+
+def rb08_paints() -> None:
+    if "renhorn-boreman-2008" not in rb.available():
+        print("### RB08 on one Mini-Diff channel: model not available\n")
+        return
+    print("### RB08 on one Mini-Diff channel (465 nm, relative loss, rb.fit defaults: 8 starts; "
+          "bulk/retro off: bulk = retro = 0 and rho_r, w_r, n_r fixed)\n")
+    print("| file | normalization | time (s) | chi2 | model evals | chi2, bulk/retro off | "
+          "time, off (s) | default reaches the off fit |")
+    print("|---|---|---|---|---|---|---|---|")
+    split = ""
+    for name in PAINTS:
+        meas = rb.read(DATA / "minidiff" / f"{name}.astm")
+        if not split:
+            for norm in ("literal", "numeric"):  # compile / load the kernels (not timed)
+                rb.fit(rb.model("renhorn-boreman-2008", normalization=norm), meas,
+                       channel=RB08_CHANNEL, starts=1, max_nfev=2, progress=False)
+            split = rb08_evaluation_split(meas)
+        for norm in ("literal", "numeric"):
+            t_full, full = rb08_paint_fit(meas, norm)
+            t_off, off = rb08_paint_fit(meas, norm, off=True)
+            print(f"| {name} | {norm} | {t_full:.2f} | {full.chi2:.4f} | {full.nfev} | "
+                  f"{off.chi2:.4f} | {t_off:.2f} | "
+                  f"{'yes' if full.chi2 <= off.chi2 else 'NO'} |", flush=True)
+    print(f"\n{split}\n")
+
+
 def main(argv: list[str] | None = None) -> None:
     import sys
 
     args = sys.argv[1:] if argv is None else argv
     if not (DATA / "minidiff").is_dir():
         print(f"skipped: real data not found at {DATA} (set ROUGHBRDF_SHARED_DATA)")
+        return
+    if "--rb08-paints" in args:  # only the RB08 paint section
+        rb08_paints()
         return
     if "--rb08" in args:  # only the RB08 section
         rb08_cea(docs="--docs" in args, scan="--scan" in args)
@@ -394,6 +465,7 @@ def main(argv: list[str] | None = None) -> None:
     global_optimum()
     table()
     rb08_cea(docs="--docs" in args, scan="--scan" in args)
+    rb08_paints()
 
 
 if __name__ == "__main__":

@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import ArgumentError
+from ..interrupts import held_interrupts
 from .objective import Objective, ObjectiveSpec
 
 if TYPE_CHECKING:
@@ -121,9 +122,13 @@ def sobol_points(lower: np.ndarray, upper: np.ndarray, n: int, seed: Any) -> np.
     d = len(lower)
     if n <= 0:
         return np.empty((0, d))
-    from scipy.stats import qmc
+    # Ctrl-C held while SciPy's compiled modules load and Sobol's direction numbers are read
+    # on first use: an interrupted extension-module initialization made Python abort at exit
+    # ("Fatal Python error") instead of ending with status 130 (roughbrdf.interrupts)
+    with held_interrupts():
+        from scipy.stats import qmc
 
-    sampler = qmc.Sobol(d, scramble=True, seed=seed)
+        sampler = qmc.Sobol(d, scramble=True, seed=seed)
     m = max(0, math.ceil(math.log2(n)))
     return lower + sampler.random_base2(m)[:n] * (upper - lower)
 
@@ -157,7 +162,8 @@ def screen(obj: Objective, candidates: np.ndarray, k: int) -> list[np.ndarray]:
 def local_fit(obj: Objective, x0: np.ndarray, tol: float, max_nfev: int | None) -> Any:
     """One ``least_squares`` (trf, ``x_scale="jac"``) of ``obj`` from ``x0`` with the
     compiled finite-difference Jacobian."""
-    from scipy.optimize import least_squares
+    with held_interrupts():  # the first import loads compiled modules (see sobol_points)
+        from scipy.optimize import least_squares
 
     return least_squares(obj.fun, x0, jac=obj.jac, bounds=(obj.spec.lower, obj.spec.upper),
                          method="trf", x_scale=X_SCALE, max_nfev=max_nfev,

@@ -34,14 +34,16 @@ from numpy.typing import ArrayLike
 
 from ._kernels import TINY, as_float_array, jit, sincos, ufunc
 
-__all__ = ["fresnel_sp", "fresnel_polarized", "fresnel_polarized_cs", "fresnel_polarized_xy",
-           "reflectance", "diffuse_reflectance",
+__all__ = ["fresnel_sp", "fresnel_amplitudes", "fresnel_polarized", "fresnel_polarized_cs",
+           "fresnel_polarized_xy", "reflectance", "diffuse_reflectance",
            "polarization_angle", "check_index"]
 
 
 @jit(inline=True, contract=False)  # plain rounding: see roughbrdf._kernels.compile.jit
-def fresnel_sp(c, n, k):
-    """Scalar part: ``(R_s, R_p)`` at ``cos t = c`` for index ``n + i k`` (docs/models.md §1.4)."""
+def _index_q(c, n, k):
+    """``(a, b, re, im)``: ``q = a + i b = sqrt((n + ik)^2 - (1 - c^2))`` (principal branch,
+    ``a >= 0``) and ``(n + ik)^2 = re + i im``; the common part of :func:`fresnel_sp` and
+    :func:`fresnel_amplitudes`."""
     s2 = 1.0 - c * c
     re = n * n - k * k  # Re (n + ik)^2
     im = 2.0 * n * k  # Im (n + ik)^2
@@ -57,6 +59,13 @@ def fresnel_sp(c, n, k):
     u = 0.5 * im / (t + TINY)  # t = 0 only if z = 0, and then im = 0: u = 0
     a = t if zr >= 0.0 else u
     b = u if zr >= 0.0 else t
+    return a, b, re, im
+
+
+@jit(inline=True, contract=False)  # plain rounding: see roughbrdf._kernels.compile.jit
+def fresnel_sp(c, n, k):
+    """Scalar part: ``(R_s, R_p)`` at ``cos t = c`` for index ``n + i k`` (docs/models.md §1.4)."""
+    a, b, re, im = _index_q(c, n, k)
     # den = 0 only for n + ik = 1 at exactly grazing incidence (z = 0, c = 0): index matched,
     # no interface; the limit along c -> 0 is R = 0, which the guarded quotients give.
     den = (c + a) * (c + a) + b * b
@@ -67,6 +76,42 @@ def fresnel_sp(c, n, k):
     rs = ((c - a) * (c - a) + b * b) * denp * inv
     rp = ((pr - a) * (pr - a) + (pi_ - b) * (pi_ - b)) * den * inv
     return rs, rp
+
+
+@jit(inline=True, contract=False)  # plain rounding, as fresnel_sp
+def fresnel_amplitudes(c, n, k):
+    """Scalar part: complex amplitudes ``(Re r_s, Im r_s, Re r_p, Im r_p)`` at ``cos t = c``.
+
+    ``r_s = (c - q)/(c + q)``, ``r_p = ((n + ik)^2 c - q)/((n + ik)^2 c + q)`` with ``q`` of
+    :func:`fresnel_sp` (time dependence ``exp(-i omega t)``, ``k >= 0``), so that
+    ``|r_s|^2 = R_s`` and ``|r_p|^2 = R_p`` to round-off. **Sign of r_p**: the reflected field
+    is referred to ``p_r = k_r × s`` and the incident one to ``p_i = k_i × s`` (``s`` the
+    common perpendicular, ``k`` the directions of propagation), SCATMECH's convention: a
+    perfect conductor has ``r_s = -1``, ``r_p = +1``, and at normal incidence
+    ``r_p = -r_s = (n + ik - 1)/(n + ik + 1)``. Other texts (Hecht, the "Verdet" form) flip
+    ``r_p``; the Mueller matrices of :mod:`roughbrdf.mueller` need this one.
+
+    Examples
+    --------
+    >>> from roughbrdf.fresnel import fresnel_amplitudes
+    >>> [round(x, 6) for x in fresnel_amplitudes(1.0, 1.5, 0.0)]   # r_p = -r_s = 0.2
+    [-0.2, -0.0, 0.2, 0.0]
+    """
+    a, b, re, im = _index_q(c, n, k)
+    den = (c + a) * (c + a) + b * b  # |c + q|^2
+    pr = re * c
+    pi_ = im * c
+    denp = (pr + a) * (pr + a) + (pi_ + b) * (pi_ + b)  # |P + q|^2, P = (n + ik)^2 c
+    # den = 0 (or denp = 0) only for n + ik = 1 at exactly grazing incidence, where the
+    # numerators vanish too: + TINY gives the limit 0 (as in fresnel_sp)
+    inv = 1.0 / (den * denp + TINY)
+    # (c - q)(c + q)* = (c - a)(c + a) - b^2 - 2i b c; (c - a) first: no cancellation near r = 0
+    rs_re = ((c - a) * (c + a) - b * b) * denp * inv
+    rs_im = -2.0 * b * c * denp * inv
+    # (P - q)(P + q)* = (Pr - a)(Pr + a) + (Pi - b)(Pi + b) + 2i (a Pi - b Pr)
+    rp_re = ((pr - a) * (pr + a) + (pi_ - b) * (pi_ + b)) * den * inv
+    rp_im = 2.0 * (a * pi_ - b * pr) * den * inv
+    return rs_re, rs_im, rp_re, rp_im
 
 
 @jit(inline=True)

@@ -32,12 +32,19 @@ from numpy.typing import ArrayLike
 from .. import _kernels
 from ..errors import ArgumentError
 from ..geometry import check_angles, check_broadcast
-from ..polarization import Polarization
+from ..polarization import Polarization, evaluate_stokes
 from ..quantity import Quantity
 from ..registry import Registry, unknown_name
 from .parameters import Parameter, ReadOnlyDict
 
-__all__ = ["Model", "PreparedGeometry", "SumModel", "components", "MODELS", "register"]
+__all__ = ["Model", "NoMuellerMatrix", "PreparedGeometry", "SumModel", "components", "MODELS",
+           "register", "require_index"]
+
+
+class NoMuellerMatrix(NotImplementedError, ValueError):
+    """The model has no Mueller matrix (:meth:`Model.mueller`). A ``NotImplementedError`` for
+    Python and, since asking for one is a usage error, a ``ValueError`` (the command line's
+    exit status 2)."""
 
 
 @dataclass(frozen=True)
@@ -231,7 +238,7 @@ class Model:
         """
         ti, tr, ph = check_angles(theta_i, theta_r, phi,
                                   grazing_incidence=self.grazing_incidence)
-        gamma = Polarization.parse(polarization).gamma
+        gamma = Polarization.parse(polarization).kernel_gamma()  # refuses Stokes/analyzer
         if gamma.ndim:
             check_broadcast(theta_i=ti, theta_r=tr, phi=ph, polarization=gamma)
         return PreparedGeometry(ti, tr, ph, gamma)
@@ -281,7 +288,11 @@ class Model:
         >>> round(m.evaluate(0.3, 0.0, 0.0, quantity="brdf_cos"), 6)   # rho cos(0)/pi
         0.159155
         """
-        g = self.prepare(theta_i, theta_r, phi, polarization)
+        pol = Polarization.parse(polarization)
+        if pol.is_polarimetric:  # Stokes vector in, analyzer out: through self.mueller
+            return evaluate_stokes(self, theta_i, theta_r, phi, pol, quantity=quantity,
+                                   term=term)
+        g = self.prepare(theta_i, theta_r, phi, pol)
         return self.evaluate_prepared(g, quantity, term=term)
 
     def brdf(self, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
@@ -309,6 +320,81 @@ class Model:
             raise NotImplementedError(f"model {self.name!r} has no compiled driver")
         return _kernels.evaluate(drive, g.theta_i, g.theta_r, g.phi, g.gamma, self._pack(), flag)
 
+    # -- Mueller matrices -----------------------------------------------------------------------
+    def mueller(self, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike, *,
+                basis: str = "psps", term: str | None = None) -> np.ndarray:
+        """The BRDF Mueller matrix in sr⁻¹, shape ``broadcast shape + (4, 4)``.
+
+        ``S_r = M S_i`` for Stokes vectors ``[I, Q, U, V]`` (columns) of the incident
+        irradiance and the reflected radiance; ``M[..., 0, 0]`` is the unpolarized
+        :meth:`brdf`. Conventions (SCATMECH's: ``Q > 0`` is s, ``V > 0`` counter-clockwise
+        seen looking toward the source) and bases in :mod:`roughbrdf.mueller`;
+        ``docs/models.md`` §11.
+
+        Parameters
+        ----------
+        theta_i, theta_r, phi : array_like
+            Angles in radians as for :meth:`evaluate` (validated the same way).
+        basis : {"psps", "xyxy"}
+            ``"psps"``: the s/p basis of each direction (SCATMECH ``psps``); ``"xyxy"``: the
+            reflected basis rotated by ``phi``, regular at the normal (SCATMECH ``xyxy``).
+        term : str, optional
+            A component of a sum, by its prefix (as for :meth:`evaluate`).
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape ``broadcast shape + (4, 4)`` (``(4, 4)`` for scalar angles), sr⁻¹.
+
+        Raises
+        ------
+        roughbrdf.errors.ArgumentError
+            Bad angles or basis; a model whose Fresnel factor is switched off (``n=None``).
+        NoMuellerMatrix
+            (a ``NotImplementedError`` and a ``ValueError``) A model without a Mueller matrix
+            (RB08: its Fresnel factor is macroscopic and unpolarized by construction,
+            ``docs/models.md`` §4.9).
+
+        Examples
+        --------
+        >>> import numpy as np, roughbrdf as rb
+        >>> m = rb.model("microfacet", distribution="beckmann", alpha=0.3, n=1.5, k=0.0)
+        >>> M = m.mueller([0.2, 0.4], 0.5, 1.0)
+        >>> M.shape
+        (2, 4, 4)
+        >>> bool(np.allclose(M[..., 0, 0], m.brdf([0.2, 0.4], 0.5, 1.0)))
+        True
+        """
+        g = self.prepare(theta_i, theta_r, phi)
+        from ..mueller import basis_code  # the Mueller machinery loads only when used
+
+        return self._mueller(g, basis_code(basis), term)
+
+    def _mueller(self, g: PreparedGeometry, basis: int, term: str | None) -> np.ndarray:
+        """The Mueller matrix hook (``basis``: a :mod:`roughbrdf.mueller` code); models with
+        one override it."""
+        raise NoMuellerMatrix(
+            f"model {self.name!r} has no Mueller matrix: the facet models (microfacet, "
+            f"torrance-sparrow-1967, trowbridge-reitz-1975, coated), lambertian, oren-nayar "
+            f"and their sums have one")
+
+    def _mueller_drive(self, drive: Callable, g: PreparedGeometry, params: tuple, basis: int,
+                       term: str | None) -> np.ndarray:
+        """Run a compiled Mueller driver ``drive(a, b, c, g, params, basis, out)`` (out of shape
+        ``(size, 4, 4)``) on prepared angles; ``term`` must be ``None`` as for ``_kernel``."""
+        if term is not None:
+            raise ArgumentError("term", f"model {self.name!r} has no separate terms",
+                                value=term)
+        nan = np.asarray(np.nan)  # the polarization slot of the driver: unused
+        return np.asarray(_kernels.evaluate(drive, g.theta_i, g.theta_r, g.phi, nan, params,
+                                            basis, out_shape=(4, 4)))
+
+    def _mueller_depolarizer(self, g: PreparedGeometry, term: str | None) -> np.ndarray:
+        """An ideal depolarizer times the unpolarized BRDF (Lambertian-like terms)."""
+        from ..mueller import depolarizer
+
+        return depolarizer(self._kernel(g, 0, term))
+
     # -- composition and description ------------------------------------------------------------
     def __add__(self, other: Model) -> SumModel:
         if not isinstance(other, Model):
@@ -331,6 +417,15 @@ class Model:
     def __repr__(self) -> str:
         args = ", ".join(f"{k}={v!r}" for k, v in {**self._options, **self._values}.items())
         return f"rb.model({self.name!r}, {args})"
+
+
+def require_index(model: Model) -> None:
+    """Raise :class:`~roughbrdf.errors.ArgumentError` naming ``n`` for a model built with
+    ``n=None`` (``F = 1``), which has no polarization physics, hence no Mueller matrix."""
+    if model.params["n"] is None:
+        raise ArgumentError("n", f"model {model.name!r} was built with n=None (F = 1): a "
+                            "facet without a complex index has no polarization physics and no "
+                            "Mueller matrix; give n (and k)", value=None)
 
 
 # --------------------------------------------------------------------------------------------
@@ -403,6 +498,20 @@ class SumModel(Model):
                 parts.append(c.evaluate_prepared(g, q, term=term))
             elif term in (c.short, c.name, pre[:-1]):
                 parts.append(c.evaluate_prepared(g, q))
+        if not parts:
+            raise ArgumentError("term", "no component of this sum has this term", value=term)
+        return sum(parts[1:], parts[0])
+
+    def _mueller(self, g: PreparedGeometry, basis: int, term: str | None) -> np.ndarray:
+        # the components' matrices added, with the term selection of _kernel
+        parts = []
+        for c, pre in zip(self.components, self.prefixes, strict=True):
+            if term is None:
+                parts.append(c._mueller(g, basis, None))
+            elif term in c.TERMS:
+                parts.append(c._mueller(g, basis, term))
+            elif term in (c.short, c.name, pre[:-1]):
+                parts.append(c._mueller(g, basis, None))
         if not parts:
             raise ArgumentError("term", "no component of this sum has this term", value=term)
         return sum(parts[1:], parts[0])

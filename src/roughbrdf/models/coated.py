@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import prange
 
 from .. import distributions as dist
@@ -48,9 +49,10 @@ from ..diffuse import (
     oren_nayar_factor,
     rough_interface,
 )
-from ..fresnel import diffuse_reflectance, fresnel_polarized_xy
+from ..fresnel import diffuse_reflectance, fresnel_polarized_xy, fresnel_sp
 from ..geometry import half_vector, tr75_eta_xy
-from .base import Model, register
+from ..mueller import facet_mueller
+from .base import Model, PreparedGeometry, register
 from .parameters import Parameter, nonnegative, positive, reflectance
 
 #: ``diffuse`` option -> code in the packed parameters
@@ -75,7 +77,9 @@ def _lobe(dcode, scode, a, ks, norm, hz, ci, cr):
 
 
 @jit(inline=True)
-def _coated_eval(ti, tr, phi, gamma, p, flag, dcode, rough):
+def _coated_terms(ti, tr, phi, gamma, p, dcode, rough):
+    """``(F, sum_j ks_j D_j G_j/(cos theta_i cos theta_r), substrate term, cos theta_i,
+    cos theta_r)``."""
     n, rho, sigma2, scode, dmode, dshadow, fdr_int = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
     scode = int(scode)
     hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
@@ -93,8 +97,35 @@ def _coated_eval(ti, tr, phi, gamma, p, flag, dcode, rough):
         diff *= oren_nayar_factor(ci, cr, si, sr, cp, sigma2)
     if dshadow > 0.0:
         diff *= ci * cr * shd.smith_g_over_cos_cos(scode, dcode, p[7], ci, cr)
+    return f, spec, diff, ci, cr
+
+
+@jit(inline=True)
+def _coated_eval(ti, tr, phi, gamma, p, flag, dcode, rough):
+    f, spec, diff, ci, cr = _coated_terms(ti, tr, phi, gamma, p, dcode, rough)
     value = 0.25 * f * spec + diff
     return value * cr if flag else value
+
+
+@jit(inline=True)
+def _substrate_mueller(out, i, diff, ci, cr, n):
+    """Add the smooth-interface substrate term: ``diff u_r u_i^T`` with
+    ``u = (1, (R_p - R_s)/(2 - R_s - R_p), 0, 0)`` at ``theta_i`` and ``theta_r``.
+
+    The light crosses the interface (Mueller transmission ``[[T, dT], [dT, T]]``, ``T = 1 -
+    (R_s + R_p)/2``, ``dT = (R_p - R_s)/2``), is depolarized by the substrate, and crosses it
+    again: row 0 gives the scalar path's ``1 - R(theta_i; gamma)``, column 0 the partial p
+    polarization of the light that leaves (``docs/models.md`` §11).
+    """
+    rsi, rpi = fresnel_sp(ci, n, 0.0)
+    rsr, rpr = fresnel_sp(cr, n, 0.0)
+    ti_, tr_ = 2.0 - rsi - rpi, 2.0 - rsr - rpr  # 2 T; 0 only at grazing, where diff = 0
+    ui = (rpi - rsi) / ti_ if ti_ > 0.0 else 0.0
+    ur = (rpr - rsr) / tr_ if tr_ > 0.0 else 0.0
+    out[i, 0, 0] += diff
+    out[i, 0, 1] += diff * ui
+    out[i, 1, 0] += diff * ur
+    out[i, 1, 1] += diff * ur * ui
 
 
 @driver
@@ -120,6 +151,25 @@ def _coated_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
         for i in prange(out.size):
             out[i] = _coated_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, flag,
                                   dist.BECKMANN, False)
+
+
+@driver
+def _coated_mueller_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
+    # Mueller matrices (roughbrdf.mueller; flag = basis code): the lobes as one facet term of
+    # index n (they share F), the substrate term of the scalar kernel (unpolarized) through
+    # the smooth interface's transmission (_substrate_mueller), or for interface="rough"
+    # (unpolarized tables) as an ideal depolarizer
+    nan = math.nan
+    dcode = int(p[16])
+    rough = p[_INTERFACE] > 0.0
+    for i in prange(out.shape[0]):
+        ti, tr, ph = at(a, i), at(b, i), at(c, i)
+        f, spec, diff, ci, cr = _coated_terms(ti, tr, ph, nan, p, dcode, rough)
+        facet_mueller(out, i, ti, tr, ph, p[0], 0.0, flag, 0.25 * spec)
+        if rough:
+            out[i, 0, 0] += diff
+        else:
+            _substrate_mueller(out, i, diff, ci, cr, p[0])
 
 
 def _lobe_parameters(j: int) -> tuple[Parameter, Parameter]:
@@ -238,3 +288,6 @@ class Coated(Model):
                 shd.get(o["shadowing"]).code, DIFFUSE[o["diffuse"]],
                 1.0 if o["shadow_diffuse"] else 0.0,
                 diffuse_reflectance(v["n"], internal=True), *lobes, d, *rough)
+
+    def _mueller(self, g: PreparedGeometry, basis: int, term: str | None) -> np.ndarray:
+        return self._mueller_drive(_coated_mueller_drive, g, self._pack(), basis, term)

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import prange
 
 from .._kernels import at, driver, jit, sincos
-from .base import Model, register
+from .base import Model, PreparedGeometry, register
 from .parameters import reflectance
 
 
@@ -53,3 +54,7 @@ class Lambertian(Model):
 
     def _pack(self) -> tuple:
         return (self._values["rho"],)
+
+    def _mueller(self, g: PreparedGeometry, basis: int, term: str | None) -> np.ndarray:
+        # an ideal depolarizer times the BRDF, in every basis (docs/models.md §11)
+        return self._mueller_depolarizer(g, term)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import prange
 
 from .. import distributions as dist
@@ -24,7 +25,8 @@ from .. import shadowing as shd
 from .._kernels import at, driver, jit
 from ..fresnel import check_index, fresnel_polarized_xy
 from ..geometry import half_vector, tr75_eta_xy
-from .base import Model, register
+from ..mueller import facet_mueller
+from .base import Model, PreparedGeometry, register, require_index
 from .parameters import Parameter, nonnegative, positive
 
 
@@ -94,6 +96,18 @@ def _micro_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
             out[i] = _micro_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, flag, dcode, scode)
 
 
+@driver
+def _micro_mueller_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
+    # Mueller matrices (roughbrdf.mueller; flag = basis code): the facet term with the facet
+    # factor ks D G/(4 cos cos) of the scalar kernel itself, run with F switched off (p[7] = 0,
+    # Microfacet._mueller_pack), and the Fresnel amplitudes of n + ik = p[1] + i p[2]
+    nan = math.nan
+    for i in prange(out.shape[0]):
+        ti, tr, ph = at(a, i), at(b, i), at(c, i)
+        f = _micro_eval(ti, tr, ph, nan, p, 0, int(p[4]), int(p[5]))
+        facet_mueller(out, i, ti, tr, ph, p[1], p[2], flag, f)
+
+
 @register
 class Microfacet(Model):
     """Microfacet BRDF with distribution, shadowing and Fresnel chosen by name.
@@ -144,3 +158,9 @@ class Microfacet(Model):
         return (alpha, v["n"] if use_f else 1.0, (v["k"] or 0.0) if use_f else 0.0,
                 v["ks"], d.code, shd.get(self._options["shadowing"]).code,
                 dist.normalization(d.code, alpha), 1.0 if use_f else 0.0)
+
+    def _mueller(self, g: PreparedGeometry, basis: int, term: str | None) -> np.ndarray:
+        require_index(self)
+        p = list(self._pack())
+        p[7] = 0.0  # the facet factor without F: the Fresnel part is the Mueller matrix's
+        return self._mueller_drive(_micro_mueller_drive, g, tuple(p), basis, term)

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import prange
 
 from .._kernels import at, driver, jit, sincos
 from ..diffuse import oren_nayar_factor
-from .base import Model, register
+from .base import Model, PreparedGeometry, register
 from .parameters import nonnegative, reflectance
 
 
@@ -70,3 +71,7 @@ class OrenNayar(Model):
     def _pack(self) -> tuple:
         v = self._floats()
         return (v["rho"], v["sigma"] ** 2)
+
+    def _mueller(self, g: PreparedGeometry, basis: int, term: str | None) -> np.ndarray:
+        # an ideal depolarizer times the BRDF, in every basis (docs/models.md §11)
+        return self._mueller_depolarizer(g, term)

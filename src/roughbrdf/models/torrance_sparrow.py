@@ -29,17 +29,21 @@ from .._kernels import at, driver, jit
 from ..errors import ArgumentError
 from ..fresnel import check_index, fresnel_polarized_xy
 from ..geometry import half_vector, tr75_eta_xy
+from ..mueller import facet_mueller
 from ..shadowing import v_groove_g_over_cos_cos, v_groove_g_over_cos_r
-from .base import Model, register
+from .base import Model, PreparedGeometry, register, require_index
 from .parameters import Parameter, nonnegative, positive, reflectance
 
 
 @jit(inline=True)
-def _ts67_eval(ti, tr, phi, gamma, p, flag, use_f):
+def _ts67_facet(ti, tr, phi, gamma, p, flag, use_f):
+    """``(g F G gauss/(cos theta_i cos theta_r), cos theta_r)``: the facet part of the absolute
+    form in units of ``rho_d/pi`` (``flag = 1``: times ``cos theta_r``); ``use_f`` False: F = 1.
+    """
     # Inlined into the driver and free of libm calls (vacos/vexp in the gaussian, eta as a
     # vector instead of atan2, selects instead of branches), so that the driver loop
     # vectorizes; see docs/benchmarks.md. flag/use_f are literals in the driver's loops.
-    g, c, n, k, rho_d = p[0], p[1], p[2], p[3], p[4]
+    g, c, n, k = p[0], p[1], p[2], p[3]
     hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
     if use_f:
         # F at the local angle; eta (TR75 Eq. 24) from the unnormalized sin(s) (cos, sin)
@@ -49,14 +53,23 @@ def _ts67_eval(ti, tr, phi, gamma, p, flag, use_f):
         f = 1.0
     gauss = dist.peak(dist.GAUSS_ANGLE, hz, c)  # exp(-(c alpha_deg)^2), TS67 Eq. 5
     t = g * f * gauss
-    if flag:  # BRIDF: f_r cos(theta_r) = rho_d/pi [g F gauss G/cos(theta_i) + cos(theta_r)]
-        # G/cos(theta_i) per branch (symmetry of G): finite also where cos(theta_i) rounds to 0
+    if flag:  # G/cos(theta_i) per branch (symmetry of G): finite also where cos(theta_i) = 0
         geo = v_groove_g_over_cos_r(cr, ci, hz, cd)
-        return rho_d / math.pi * ((t * geo if t > 0.0 else 0.0) + cr)
-    # G/(cos theta_i cos theta_r) per branch: finite at theta_r = 90 deg (docs/models.md §2.5) and
-    # where cos(theta_i) rounds to 0; t = 0 (gaussian underflow) gives 0, never 0 * inf
-    geo = v_groove_g_over_cos_cos(ci, cr, hz, cd)
-    return rho_d / math.pi * ((t * geo if t > 0.0 else 0.0) + 1.0)
+    else:
+        # G/(cos theta_i cos theta_r) per branch: finite at theta_r = 90 deg (docs/models.md
+        # §2.5) and where cos(theta_i) rounds to 0
+        geo = v_groove_g_over_cos_cos(ci, cr, hz, cd)
+    # t = 0 (gaussian underflow) gives 0, never 0 * inf
+    return (t * geo if t > 0.0 else 0.0), cr
+
+
+@jit(inline=True)
+def _ts67_eval(ti, tr, phi, gamma, p, flag, use_f):
+    facet, cr = _ts67_facet(ti, tr, phi, gamma, p, flag, use_f)
+    rho_d = p[4]
+    if flag:  # BRIDF: f_r cos(theta_r) = rho_d/pi [g F gauss G/cos(theta_i) + cos(theta_r)]
+        return rho_d / math.pi * (facet + cr)
+    return rho_d / math.pi * (facet + 1.0)
 
 
 @jit(inline=True)
@@ -85,6 +98,20 @@ def _ts67_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
     else:
         for i in prange(out.size):
             out[i] = _ts67_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, 0, False)
+
+
+@driver
+def _ts67_mueller_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
+    # Mueller matrices (roughbrdf.mueller; flag = basis code): the facet part of the scalar
+    # kernel with F = 1 as the facet factor, n + ik = p[2] + i p[3], and the diffuse part
+    # rho_d/pi as an ideal depolarizer
+    nan = math.nan
+    kd = p[4] / math.pi
+    for i in prange(out.shape[0]):
+        ti, tr, ph = at(a, i), at(b, i), at(c, i)
+        facet = _ts67_facet(ti, tr, ph, nan, p, 0, False)[0]
+        facet_mueller(out, i, ti, tr, ph, p[2], p[3], flag, kd * facet)
+        out[i, 0, 0] += kd
 
 
 @register
@@ -151,6 +178,10 @@ class TorranceSparrow1967(Model):
                 v["rho_d"], 1.0 if use_f else 0.0)
 
     _drive = _ts67_drive
+
+    def _mueller(self, g: PreparedGeometry, basis: int, term: str | None) -> np.ndarray:
+        require_index(self)
+        return self._mueller_drive(_ts67_mueller_drive, g, self._pack(), basis, term)
 
     def relative(self, theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
                  polarization=None) -> np.ndarray | float:

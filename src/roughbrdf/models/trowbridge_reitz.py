@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import prange
 
 from .. import distributions as dist
@@ -30,16 +31,15 @@ from .. import shadowing as shd
 from .._kernels import at, driver, jit
 from ..fresnel import check_index, fresnel_polarized_xy
 from ..geometry import half_vector, tr75_eta_xy
-from .base import Model, register
+from ..mueller import facet_mueller
+from .base import Model, PreparedGeometry, register
 from .parameters import nonnegative, positive, reflectance
 
 
 @jit(inline=True)
-def _tr75_point(ti, tr, phi, gamma, p, flag):
-    e, n, k, rho_l, shadow = p[0], p[1], p[2], p[3], p[4]
-    hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
-    ex, ey = tr75_eta_xy(si, ci, hx, hy, hz)  # sin(s) (cos, sin) eta, Eq. 23 (docs/models.md §3.5)
-    r = fresnel_polarized_xy(cd, n, k, gamma, ex, ey)
+def _tr75_value(r, hz, cd, ci, cr, e, rho_l, shadow, flag):
+    """Eq. 33 for the reflectance ``r`` (``flag = 1``: BRIDF; 0: BRDF); with ``r = 1`` and
+    ``rho_l = 0`` the specular part's factor without R, exactly (``x + 0 = x``)."""
     spec4 = 0.25 * r * dist.trowbridge_reitz_d(hz, e)  # R D/4; Eq. 30 = spec4/cos(theta_i)
     if flag:  # BRIDF, Eq. 33
         if shadow > 0.0:  # G/cos(theta_i) per branch (G symmetric), finite at grazing
@@ -56,6 +56,15 @@ def _tr75_point(ti, tr, phi, gamma, p, flag):
     return spec4 / den + rho_l / math.pi
 
 
+@jit(inline=True)
+def _tr75_point(ti, tr, phi, gamma, p, flag):
+    e, n, k, rho_l, shadow = p[0], p[1], p[2], p[3], p[4]
+    hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
+    ex, ey = tr75_eta_xy(si, ci, hx, hy, hz)  # sin(s) (cos, sin) eta, Eq. 23 (docs/models.md §3.5)
+    r = fresnel_polarized_xy(cd, n, k, gamma, ex, ey)
+    return _tr75_value(r, hz, cd, ci, cr, e, rho_l, shadow, flag)
+
+
 @driver
 def _tr75_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
     # one loop per quantity, with the flag a literal: the compiler then drops the other
@@ -66,6 +75,20 @@ def _tr75_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
     else:
         for i in prange(out.size):
             out[i] = _tr75_point(at(a, i), at(b, i), at(c, i), at(g, i), p, 0)
+
+
+@driver
+def _tr75_mueller_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
+    # Mueller matrices (roughbrdf.mueller; flag = basis code): the specular part with R = 1 as
+    # the facet factor, n + ik = p[1] + i p[2], and the Lambertian part rho_L/pi as an ideal
+    # depolarizer
+    kd = p[3] / math.pi
+    for i in prange(out.shape[0]):
+        ti, tr, ph = at(a, i), at(b, i), at(c, i)
+        hz, cd, ci, cr = half_vector(ti, tr, ph)[2:6]
+        facet_mueller(out, i, ti, tr, ph, p[1], p[2], flag,
+                      _tr75_value(1.0, hz, cd, ci, cr, p[0], 0.0, p[4], 0))
+        out[i, 0, 0] += kd
 
 
 @register
@@ -119,3 +142,6 @@ class TrowbridgeReitz1975(Model):
         v = self._floats()
         return (v["e"], v["n"], v["k"], v["rho_L"],
                 1.0 if self._options["shadowing"] == "v-groove" else 0.0)
+
+    def _mueller(self, g: PreparedGeometry, basis: int, term: str | None) -> np.ndarray:
+        return self._mueller_drive(_tr75_mueller_drive, g, self._pack(), basis, term)

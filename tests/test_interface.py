@@ -76,9 +76,16 @@ def test_bad_polarization_names_the_value(bad, match):
         MODELS[0].brdf(0.5, 0.5, 0.0, bad)
 
 
-def test_stokes_and_analyzer_are_refused_not_ignored():
+def test_stokes_and_analyzer_are_used_not_ignored():
+    # issue 13: the reserved fields are implemented (tests/test_stokes.py); where a path has no
+    # Stokes evaluation (prepare: the scalar kernels) they are refused, never dropped
+    pol = Polarization(np.asarray(np.nan), stokes=(1.0, 0.0, 0.0, 0.0),
+                       analyzer=(0.5, 0.5, 0.0, 0.0))
+    assert pol.is_polarimetric
+    s_only = MODELS[0].evaluate(0.3, 0.3, 0.0, polarization=pol)
+    assert s_only == pytest.approx(0.5 * MODELS[0].evaluate(0.3, 0.3, 0.0, polarization="s"))
     with pytest.raises(ValueError, match="Stokes"):
-        Polarization(np.asarray(np.nan), stokes=(1.0, 0.0, 0.0, 0.0))
+        MODELS[0].prepare(0.1, 0.2, 0.0, pol)
 
 
 def test_bad_quantity_names_the_value():

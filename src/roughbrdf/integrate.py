@@ -62,7 +62,8 @@ def albedo(model: Model, theta_i: ArrayLike, *, polarization=None, n_psi: int = 
         if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < least:
             raise ArgumentError(name, f"{name} must be an integer >= {least}, got {v!r}")
     ti = check_zenith(theta_i, "theta_i", open_upper=not model.grazing_incidence)
-    gamma = Polarization.parse(polarization).gamma
+    # kernel_gamma refuses a Stokes/analyzer setting (the albedo integrates the scalar kernel)
+    gamma = Polarization.parse(polarization).kernel_gamma()
     if gamma.ndim:
         raise ArgumentError("polarization", "albedo takes one polarization for all "
                             "incidences (a name or one angle gamma)")

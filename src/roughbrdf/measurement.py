@@ -4,6 +4,32 @@ Data flows one way: file -> reader (:mod:`roughbrdf.io`) -> :class:`Measurement`
 ``FitResult``. A measurement never silently drops samples: non-finite and negative values are
 counted by :meth:`Measurement.validate` and reported; a fit chooses what to do with them by an
 explicit option and :meth:`Measurement.drop`, which returns what it removed.
+
+Polarimetric data
+-----------------
+A measurement may hold **Mueller-matrix elements** instead of one value per wavelength: then
+``mueller`` says how they are stored and every channel is an element named ``m00`` ... ``m33``
+(:data:`MUELLER_ELEMENTS`; row ``i`` = output Stokes component, column ``j`` = input one;
+``m00`` required, any subset of the others, one wavelength per measurement):
+
+* ``mueller="absolute"``: every element in the unit of ``quantity`` (sr⁻¹ for ``brdf``);
+* ``mueller="normalized"``: ``m00`` in the unit of ``quantity`` and the others divided by
+  ``m00`` (dimensionless, in [-1, 1] for a physical matrix).
+
+``mueller_basis`` names the polarization basis of the elements, as
+:meth:`roughbrdf.models.Model.mueller` does: ``"psps"`` (default; the s/p basis of each
+direction, ``docs/models.md`` and :mod:`roughbrdf.mueller`) or ``"xyxy"``.
+:meth:`Measurement.mueller_array` returns the ``(N, 4, 4)`` matrices; ``m00`` is the
+unpolarized BRDF. Mueller data describe every incident state at once, so such a measurement has
+no ``polarization`` column.
+
+Examples
+--------
+>>> import numpy as np
+>>> m = Measurement([0.5], [0.5], [0.0], [[0.8, 0.1]], channels=["m00", "m01"],
+...                 mueller="normalized")
+>>> m.mueller, m.mueller_basis, m.mueller_array("absolute")[0, 0, :2].tolist()
+('normalized', 'psps', [0.8, 0.08000000000000002])
 """
 
 from __future__ import annotations
@@ -19,13 +45,21 @@ from .errors import ArgumentError
 from .geometry import check_angles
 from .quantity import Quantity
 
-__all__ = ["Measurement", "QUANTITIES"]
+__all__ = ["Measurement", "QUANTITIES", "MUELLER_ELEMENTS", "MUELLER_KINDS", "MUELLER_BASES"]
 
 #: What a measurement's values hold: the names of :class:`~roughbrdf.quantity.Quantity`.
 #: ``brdf`` f_r (sr⁻¹); ``brdf_cos`` f_r cos(theta_r) (ALTA INV_STERADIAN_COSINE_FACTOR);
 #: ``bridf`` TR75's BRIDF (identical to brdf_cos, kept as its own name); ``relative`` any
 #: quantity proportional to f_r with an unknown scale (TR75's relative BRIDF is relative x cos).
 QUANTITIES = tuple(q.value for q in Quantity)
+
+#: the channel names of Mueller-matrix elements, row-major: ``m<i><j>``, ``i`` the output and
+#: ``j`` the input Stokes component (``I, Q, U, V`` = 0, 1, 2, 3)
+MUELLER_ELEMENTS = tuple(f"m{i}{j}" for i in range(4) for j in range(4))
+#: how Mueller elements are stored (:attr:`Measurement.mueller`)
+MUELLER_KINDS = ("absolute", "normalized")
+#: the polarization bases of :meth:`roughbrdf.models.Model.mueller`
+MUELLER_BASES = ("psps", "xyxy")
 
 #: provenance keys that every reader fills in ``meta`` (None when the file does not say)
 PROVENANCE = ("file", "format", "sample", "instrument", "date")
@@ -61,6 +95,12 @@ class Measurement:
         writer of the same format writes them all back); ``meta["file_abs"]`` is the absolute
         path of the file read, which no writer replaces
         (:func:`roughbrdf.io.write` refuses it even with ``overwrite=True``).
+    mueller : {None, "absolute", "normalized"}
+        None for ordinary data; else the channels are Mueller elements ``m00`` ... ``m33``,
+        absolute or (all but ``m00``) divided by ``m00`` (module notes, "Polarimetric data").
+    mueller_basis : {None, "psps", "xyxy"}
+        Polarization basis of the Mueller elements (default ``"psps"`` when ``mueller`` is
+        set; None otherwise).
     """
 
     theta_i: np.ndarray
@@ -73,6 +113,8 @@ class Measurement:
     uncertainty: np.ndarray | None = None
     original: dict[str, np.ndarray] = field(default_factory=dict)
     meta: dict[str, Any] = field(default_factory=dict)
+    mueller: str | None = None
+    mueller_basis: str | None = None
 
     def __post_init__(self) -> None:
         self.theta_i = np.asarray(self.theta_i, dtype=float).reshape(-1)
@@ -124,6 +166,37 @@ class Measurement:
             orig[str(k)] = a
         self.original = orig
         self.meta = dict(self.meta or {})
+        self._check_mueller(where)
+
+    def _check_mueller(self, where: str) -> None:
+        """The Mueller declaration: a known kind and basis, element channels with ``m00``, no
+        ``polarization``; ArgumentError naming the argument otherwise."""
+        if self.mueller is None:
+            if self.mueller_basis is not None:
+                raise ArgumentError("mueller_basis", "a polarization basis only describes "
+                                    f"Mueller data: give mueller= too{where}",
+                                    value=self.mueller_basis)
+            return
+        kind = str(self.mueller).strip().lower() if isinstance(self.mueller, str) else None
+        if kind not in MUELLER_KINDS:
+            raise ArgumentError("mueller", f"must be None or one of {', '.join(MUELLER_KINDS)}"
+                                f"{where}", value=self.mueller)
+        basis = "psps" if self.mueller_basis is None else self.mueller_basis
+        basis = str(basis).strip().lower() if isinstance(basis, str) else None
+        if basis not in MUELLER_BASES:
+            raise ArgumentError("mueller_basis", f"must be one of {', '.join(MUELLER_BASES)}"
+                                f"{where}", value=self.mueller_basis)
+        other = [c for c in self.channels if c not in MUELLER_ELEMENTS]
+        if other or "m00" not in self.channels:
+            raise ArgumentError("channels", "Mueller data need the channel 'm00' and only "
+                                "element channels m00 ... m33" + (
+                                    f" (not elements: {other})" if other else "") + where,
+                                value=self.channels)
+        if self.polarization is not None:
+            raise ArgumentError("polarization", "Mueller data hold every incident "
+                                f"polarization at once: no per-sample polarization{where}")
+        object.__setattr__(self, "mueller", kind)
+        object.__setattr__(self, "mueller_basis", basis)
 
     def __setattr__(self, name: str, value: Any) -> None:
         # once constructed (meta is the last field set by __init__), an assigned quantity is
@@ -146,6 +219,39 @@ class Measurement:
     @property
     def n_channels(self) -> int:
         return int(self.values.shape[1])
+
+    @property
+    def is_mueller(self) -> bool:
+        """Whether the channels are Mueller-matrix elements (:attr:`mueller` is set)."""
+        return self.mueller is not None
+
+    def mueller_array(self, kind: str = "normalized") -> np.ndarray:
+        """The Mueller matrices of the samples, shape (N, 4, 4); NaN for elements not held.
+
+        ``kind="normalized"`` divides by ``m00`` (``[0, 0]`` is then 1, NaN where ``m00``
+        is 0); ``"absolute"`` gives every element in the unit of :attr:`quantity`. Raises
+        :class:`~roughbrdf.errors.ArgumentError` for a measurement without Mueller data or an
+        unknown ``kind``.
+        """
+        if not self.is_mueller:
+            raise ArgumentError("mueller", "this measurement holds no Mueller elements")
+        if kind not in MUELLER_KINDS:
+            raise ArgumentError("kind", f"must be one of {', '.join(MUELLER_KINDS)}", value=kind)
+        out = np.full((self.n_samples, 16), np.nan)
+        for j, ch in enumerate(self.channels):
+            out[:, MUELLER_ELEMENTS.index(ch)] = self.values[:, j]
+        m00 = out[:, :1].copy()
+        if kind == "absolute":
+            if self.mueller == "normalized":  # the others times m00; m00 itself stays
+                out[:, 1:] *= m00
+            return out.reshape(-1, 4, 4)
+        if self.mueller == "absolute":
+            with np.errstate(divide="ignore", invalid="ignore"):
+                out /= m00
+        out[:, 0] = 1.0
+        # m00 = 0 (or not finite) has no normalized matrix: NaN there, not inf or 1
+        out[~(np.isfinite(m00[:, 0]) & (m00[:, 0] != 0))] = np.nan
+        return out.reshape(-1, 4, 4)
 
     def __len__(self) -> int:
         return self.n_samples
@@ -176,21 +282,40 @@ class Measurement:
     def validate(self) -> dict[str, dict[str, int]]:
         """Count non-finite and negative values per channel (nothing is removed).
 
-        Returns ``{channel: {"n": N, "nonfinite": count, "negative": count}}``.
+        Returns ``{channel: {"n": N, "nonfinite": count, "negative": count}}``. For Mueller data
+        (:attr:`mueller`) negative values of the elements other than ``m00`` are normal; those
+        elements also get ``"beyond_m00"``: the count of ``|m_ij| > m00`` (``|m_ij| > 1`` when
+        normalized), which no physical Mueller matrix has (noise can give it).
         """
         report = {}
+        m00 = (np.ones(self.n_samples) if self.mueller == "normalized"
+               else self.values[:, self.channel_index("m00")]) if self.is_mueller else None
         for j, ch in enumerate(self.channels):
             col = self.values[:, j]
             report[ch] = {"n": int(col.size), "nonfinite": int((~np.isfinite(col)).sum()),
                           "negative": int((col < 0).sum())}
+            if m00 is not None and ch != "m00":
+                report[ch]["beyond_m00"] = int((np.abs(col) > m00).sum())
         return report
+
+    def _problems(self, ch: str, r: dict[str, int]) -> list[str]:
+        """The counts of :meth:`validate` for one channel that point at a problem, in words."""
+        out = [f"{r['nonfinite']} non-finite"] if r["nonfinite"] else []
+        if r["negative"] and (not self.is_mueller or ch == "m00"):
+            out.append(f"{r['negative']} negative")
+        if r.get("beyond_m00"):
+            out.append(f"{r['beyond_m00']} with |{ch}| > m00")
+        return out
 
     def validation_text(self) -> str:
         """One line per channel with the counts of :meth:`validate` (for reports and the CLI)."""
         lines = []
         for ch, r in self.validate().items():
-            lines.append(f"channel {ch}: {r['n']} values, {r['nonfinite']} non-finite, "
-                         f"{r['negative']} negative")
+            line = (f"channel {ch}: {r['n']} values, {r['nonfinite']} non-finite, "
+                    f"{r['negative']} negative")
+            if "beyond_m00" in r:
+                line += f", {r['beyond_m00']} with |{ch}| > m00"
+            lines.append(line)
         return "\n".join(lines)
 
     def bad_mask(self, *, nonfinite: bool = True, negative: bool = False,
@@ -273,9 +398,18 @@ class Measurement:
             meta=dict(self.meta),
         )
 
+    def _check_mueller_selection(self, idx: list[int]) -> None:
+        """A selection of a Mueller measurement's channels must keep ``m00`` (the others are
+        relative to it or meaningless without it)."""
+        if self.is_mueller and "m00" not in [self.channels[j] for j in idx]:
+            raise ArgumentError("channel", "a selection of Mueller elements must include "
+                                "'m00' (use mueller_array() for single elements)",
+                                value=[self.channels[j] for j in idx])
+
     def select_channel(self, channel: int | str) -> Measurement:
-        """A single-channel measurement."""
+        """A single-channel measurement (of Mueller data: only ``m00``)."""
         j = self.channel_index(channel)
+        self._check_mueller_selection([j])
         return replace(self, values=self.values[:, j:j + 1], channels=[self.channels[j]],
                        uncertainty=None if self.uncertainty is None
                        else self.uncertainty[:, j:j + 1], meta=dict(self.meta))
@@ -283,6 +417,7 @@ class Measurement:
     def select_channels(self, channels: list[int | str]) -> Measurement:
         """A measurement with the given channels, in the given order."""
         idx = [self.channel_index(c) for c in channels]
+        self._check_mueller_selection(idx)
         return replace(self, values=self.values[:, idx], channels=[self.channels[j] for j in idx],
                        uncertainty=None if self.uncertainty is None
                        else self.uncertainty[:, idx], meta=dict(self.meta))
@@ -326,7 +461,14 @@ class Measurement:
             return self.values
         c = np.cos(self.theta_r)[:, None]
         with np.errstate(divide="ignore", invalid="ignore"):
-            return self.values / c
+            return self.values / c ** self._scaled_columns()
+
+    def _scaled_columns(self) -> np.ndarray:
+        """(C,) 1 for the columns that carry the quantity's unit, 0 for the others (the
+        normalized Mueller elements, which are ratios)."""
+        if self.mueller != "normalized":
+            return np.ones(self.n_channels)
+        return np.array([1.0 if c == "m00" else 0.0 for c in self.channels])
 
     def as_quantity(self, quantity: Quantity | str) -> Measurement:
         """The same samples holding ``quantity`` (``brdf`` <-> ``brdf_cos``/``bridf``).
@@ -349,6 +491,7 @@ class Measurement:
             c = np.cos(self.theta_r)[:, None]
             with np.errstate(divide="ignore", invalid="ignore"):
                 factor = c if target.cosine_weighted else 1.0 / c
+        factor = factor ** self._scaled_columns()  # normalized Mueller elements: ratios, kept
         return replace(self, values=self.values * factor, quantity=target,
                        uncertainty=None if self.uncertainty is None
                        else self.uncertainty * np.abs(factor), meta=dict(self.meta))
@@ -360,8 +503,9 @@ class Measurement:
         text = (f"{self.meta.get('file', '<memory>')}: {self.n_samples} samples x "
                 f"{len(self.channels)} channels {self.channels}, quantity {self.quantity}, "
                 f"incidences [{inc}] deg; sample {self.meta.get('sample', '?')!r}")
-        bad = {ch: r for ch, r in self.validate().items() if r["nonfinite"] or r["negative"]}
+        if self.is_mueller:
+            text += f"; Mueller elements ({self.mueller}, basis {self.mueller_basis})"
+        bad = {ch: p for ch, r in self.validate().items() if (p := self._problems(ch, r))}
         if bad:
-            text += "; " + ", ".join(f"{ch}: {r['nonfinite']} non-finite, {r['negative']} "
-                                     "negative" for ch, r in bad.items())
+            text += "; " + ", ".join(f"{ch}: {', '.join(p)}" for ch, p in bad.items())
         return text

@@ -181,6 +181,8 @@ def result_names(meas: Measurement, channel: list[str] | None, plots: bool,
     ``compare.png`` for ``--model auto``)."""
     labels = ([meas.channels[meas.channel_index(c)] for c in channel] if channel
               else list(meas.channels))
+    if getattr(meas, "mueller", None):  # Mueller elements are fitted as one "channel"
+        labels = ["mueller"]
     names = ["fit.json", "report.txt"]
     if plots:
         for label in labels:

@@ -76,6 +76,7 @@ def fit(model: Model | str, measurement: Measurement, *,
         aperture_points: int = 19, theta_r_max: float | None = None,
         source_exclusion: float | None = None, extrapolated: str = "drop",
         joint: bool = False, shared: Iterable[str] | None = None,
+        polarimetric_weight: float | None = None,
         progress: bool | None = None) -> FitResult:
     """Fit ``model`` to ``measurement``, each channel on its own.
 
@@ -164,12 +165,19 @@ def fit(model: Model | str, measurement: Measurement, *,
     shared : iterable of str, optional
         With ``joint=True``: the free parameters common to all channels. Default: every free
         parameter that is not a reflectance (roughness, index, lobe scales).
+    polarimetric_weight : float, optional
+        Mueller data only (``measurement.mueller`` set, :mod:`~roughbrdf.fitting.polarimetric`):
+        the weight of the absolute residuals of the normalized elements ``m_ij/m00`` against
+        the ``loss`` residuals of ``m00`` (default 1).
     progress : bool or None
         Show a tqdm progress bar; ``None`` shows it only on an interactive terminal.
 
     Returns
     -------
     FitResult
+        For Mueller data a :class:`~roughbrdf.fitting.polarimetric.MuellerFitResult`: every
+        element is fitted at once (one channel, ``"mueller"``; ``docs/fitting.md``,
+        "Polarimetric data").
 
     Raises
     ------
@@ -184,6 +192,21 @@ def fit(model: Model | str, measurement: Measurement, *,
         the command line).
     """
     t_start = time.perf_counter()
+    if getattr(measurement, "mueller", None) is not None:  # Mueller elements: all at once
+        from .polarimetric import POLARIMETRIC_WEIGHT, fit_mueller
+
+        return fit_mueller(
+            model, measurement, loss=loss, weights=weights, fix=fix, bounds=bounds,
+            polarimetric_weight=POLARIMETRIC_WEIGHT if polarimetric_weight is None
+            else polarimetric_weight, starts=starts, seed=seed, nonfinite=nonfinite,
+            negative=negative, relative_to=relative_to, free_scale=free_scale, scale=scale,
+            screen=screen, subsample=subsample, polish=polish, max_nfev=max_nfev,
+            aperture=aperture, aperture_points=aperture_points, theta_r_max=theta_r_max,
+            source_exclusion=source_exclusion, extrapolated=extrapolated, channel=channel,
+            joint=joint, shared=shared, progress=progress)
+    if polarimetric_weight is not None:
+        raise ArgumentError("polarimetric_weight", "only Mueller data (measurement.mueller "
+                            "set) have normalized elements to weigh", value=polarimetric_weight)
     if isinstance(model, str) and model.strip().lower() == "auto":
         return fit_auto(measurement, channel=channel, loss=loss, weights=weights, fix=fix,
                         bounds=bounds, starts=starts, seed=seed, nonfinite=nonfinite,

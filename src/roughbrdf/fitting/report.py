@@ -50,6 +50,8 @@ def report(result: FitResult, *, min_correl: float = 0.1) -> str:
     lines = _header(result)
     for c in result.channels:
         lines += ["", *_channel(c), *_variables(c), *_correlations(c, min_correl)]
+        # a Mueller fit's channel adds its normalized elements (fitting.polarimetric)
+        lines += getattr(c, "report_lines", list)()
     if result.model_choice is not None:
         lines += ["", "[[Model choice]] candidates sorted by BIC (best first; chosen: "
                   f"{result.model_choice.best.label})", result.model_choice.table()]
@@ -67,12 +69,26 @@ def _header(result: FitResult) -> list[str]:
             f"    data quantity      = {result.measurement.quantity}",
             f"    compared with      = {comp}",
             f"    loss               = {_LOSS_TEXT[result.loss]}",
+            *_mueller_text(result.options),
             "    aperture           = " + (
                 "none (model at each measured direction)" if ap is None else ap.describe()),
             f"    fit domain         = {_domain_text(result.options)}",
             *_not_measured(result),
             f"    channels           = {len(result.channels)}" + _joint_text(result.options),
             f"    time               = {result.elapsed:.3g} s"]
+
+
+def _mueller_text(options: dict) -> list[str]:
+    """The line of a Mueller fit (:mod:`~roughbrdf.fitting.polarimetric`), else nothing."""
+    mu = options.get("mueller")
+    if not mu:
+        return []
+    els = mu["elements"]
+    which = (f"the {len(els)} other elements" if len(els) == 15
+             else ", ".join(els) or "no other element")
+    return [f"    polarimetric       = Mueller elements ({mu['kind']}, basis {mu['basis']}): "
+            f"m00 by the loss above, {which} as m_ij/m00 by absolute difference "
+            f"x {mu['polarimetric_weight']:g}"]
 
 
 def _not_measured(result: FitResult) -> list[str]:

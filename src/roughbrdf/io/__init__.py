@@ -203,10 +203,16 @@ def write(measurement: Measurement, path: str | os.PathLike, format: str | None 
     IsADirectoryError
         ``path`` is a folder.
     ValueError
-        A measurement the format cannot hold (e.g. relative values in ASTM).
+        A measurement the format cannot hold (e.g. relative values in ASTM, Mueller elements
+        in anything but CSV).
     """
     fmt = format_for(path, format)
     mod = _module(fmt)
     if not hasattr(mod, "write"):
         raise FormatError(f"format {fmt!r} has no writer", path)
+    if getattr(measurement, "mueller", None) and fmt != "csv":
+        # the other formats would write the elements as plain BRDF channels: refuse
+        raise ValueError(f"{path}: a measurement of Mueller elements ({measurement.mueller}) "
+                         f"can be written as roughbrdf CSV only (its '# mueller:' line says "
+                         f"what the columns hold); the {fmt} format has no place for that")
     return mod.write(measurement, path, overwrite=overwrite, **options)

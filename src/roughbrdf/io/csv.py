@@ -21,6 +21,13 @@ Header (``#`` lines before the column names, each ``# key: value``):
   single value column is named after a quantity, e.g. ``brdf``, or ``quantity=`` is given);
 * ``# relative_to: brdf|bridf`` - for ``relative`` data, whether the values are proportional to
   the BRDF or to BRDF x cos(theta_r) (TR75's relative BRIDF); read by ``rb.fit``;
+* ``# mueller: absolute|normalized`` - the value columns are Mueller-matrix elements
+  ``m00`` ... ``m33`` (``Measurement.mueller``): all in the unit of ``quantity``, or ``m00`` in
+  that unit and the others divided by ``m00``; required when such columns are present, and
+  then every value column must be an element, ``m00`` among them, and there is no
+  ``polarization`` column;
+* ``# mueller_basis: psps|xyxy`` - the polarization basis of those elements (default ``psps``,
+  :mod:`roughbrdf.mueller`); only with ``# mueller:``;
 * optional provenance: ``sample``, ``instrument``, ``date``, ``source_file``, ``source_format``
   and any other ``key: value`` (kept as strings in ``Measurement.meta``).
 
@@ -29,7 +36,9 @@ Columns (comma separated, first non-``#`` line; order free):
 * ``theta_i``, ``theta_r``, ``phi`` - the library's common frame: incidence zenith, reflection
   zenith, reflection azimuth with ``phi = 0`` on the forward (specular) side and ``phi = 180°``
   on the source (retro) side; each may carry a unit suffix ``_deg``/``_rad``;
-* every other column is a **channel** (value column) named by its label, e.g. ``525nm``;
+* every other column is a **channel** (value column) named by its label, e.g. ``525nm``, or a
+  Mueller element ``m<i><j>`` (``i`` output, ``j`` input Stokes component, 0-3) under
+  ``# mueller:``;
 * ``sigma_<label>`` - one-sigma uncertainty of channel ``<label>`` (all channels or none);
 * ``polarization`` - incident polarization angle gamma from the plane of incidence, in the
   declared angle unit, or ``s``/``p``/``unpolarized``; ``nan`` or empty means unpolarized;
@@ -61,7 +70,7 @@ from typing import Any
 import numpy as np
 
 from ..fresnel import polarization_angle
-from ..measurement import QUANTITIES, Measurement
+from ..measurement import MUELLER_BASES, MUELLER_ELEMENTS, MUELLER_KINDS, QUANTITIES, Measurement
 from ..quantity import Quantity
 from ._common import (
     LAYOUT,
@@ -91,6 +100,9 @@ _ANGLES = ("theta_i", "theta_r", "phi")
 _SUFFIX = re.compile(r"^(theta_i|theta_r|phi|polarization)_(deg|rad)$")
 #: header keys that declare the angle unit, first found wins
 _UNIT_KEYS = ("angles", "angle_units", "units")
+#: header keys of the Mueller declaration: attributes of the measurement, not ``meta``
+_MUELLER_KEYS = ("mueller", "mueller_basis")
+_ELEMENT = re.compile(r"^m[0-3][0-3]$", re.IGNORECASE)
 #: provenance keys taken from ``meta`` when writing (an edited ``meta["sample"]`` is written)
 _PROVENANCE = ("sample", "instrument", "date", "relative_to")
 _MISSING_UNITS = ("missing angle units: add a header line '# angles: deg' or '# angles: rad' "
@@ -268,6 +280,42 @@ def _read_quantity(header: _Header, roles: _Roles, quantity: str | None, path: P
     return q
 
 
+def _read_mueller(header: _Header, roles: _Roles, path: Path, line: int
+                  ) -> tuple[str | None, str | None]:
+    """Mueller phase: ``# mueller:`` and ``# mueller_basis:`` against the columns. Element
+    columns need the declaration (absolute or normalized cannot be guessed); a declaration
+    needs ``m00``, only element columns and no ``polarization`` column."""
+    kind, basis = header.keys.get("mueller"), header.keys.get("mueller_basis")
+    elements = [c for c in roles.channels if _ELEMENT.match(c)]
+    if kind is None:
+        if basis is not None:
+            raise FormatError("'# mueller_basis:' without '# mueller: absolute|normalized'",
+                              path, header.line("mueller_basis"))
+        if elements:
+            raise FormatError(f"columns {elements} look like Mueller elements: declare them "
+                              "with a header line '# mueller: normalized' (elements other than "
+                              "m00 divided by m00) or '# mueller: absolute'", path, line)
+        return None, None
+    kline = header.line("mueller")
+    if kind.strip().lower() not in MUELLER_KINDS:
+        raise FormatError(f"mueller {kind!r} is not one of {', '.join(MUELLER_KINDS)}", path,
+                          kline)
+    if basis is not None and basis.strip().lower() not in MUELLER_BASES:
+        raise FormatError(f"mueller_basis {basis!r} is not one of {', '.join(MUELLER_BASES)}",
+                          path, header.line("mueller_basis"))
+    other = [c for c in roles.channels if c not in MUELLER_ELEMENTS]
+    if other or "m00" not in roles.channels:
+        raise FormatError(f"'# mueller: {kind}' (line {kline}) needs a column m00 and only "
+                          "Mueller element columns m00 ... m33 besides the angles"
+                          + (f"; not elements: {other}" if other else "; m00 is missing"),
+                          path, line)
+    if roles.pol_col is not None:
+        raise FormatError(f"'# mueller: {kind}' (line {kline}) and a polarization column "
+                          "contradict each other: Mueller elements hold every incident "
+                          "polarization at once", path, line)
+    return kind.strip().lower(), (basis or "psps").strip().lower()
+
+
 def _read_polarization(texts: list[str], linenos: list[int], cols: _Columns, pol_col: int,
                        unit: AngleUnit, path: Path) -> tuple[list[str], np.ndarray]:
     """Rows phase, ``polarization`` column: an angle in the file's unit, ``s``/``p``/
@@ -333,7 +381,7 @@ def _meta(header: _Header, path: Path, unit: AngleUnit, has_original: bool) -> d
     strings), with ``sample``, ``instrument``, ``date`` always present."""
     keys = header.keys
     meta: dict[str, Any] = {k: v for k, v in keys.items()
-                            if k not in ("angles", "quantity", "format_version")}
+                            if k not in ("angles", "quantity", "format_version", *_MUELLER_KEYS)}
     meta.update({
         "file": str(path),
         "file_abs": str(path.resolve()),
@@ -373,9 +421,11 @@ def read(path: str | os.PathLike, *, angles: str | None = None, quantity: str | 
     unit = _read_units(header, cols, angles, path)
     roles = _read_roles(cols, path)
     q = _read_quantity(header, roles, quantity, path, cols.line)
+    kind, basis = _read_mueller(header, roles, path, cols.line)
     arrays = _read_rows(lines, header, cols, roles, unit, path)
     meta = _meta(header, path, unit, bool(arrays["original"]))
-    return Measurement(channels=roles.channels, quantity=q, meta=meta, **arrays)
+    return Measurement(channels=roles.channels, quantity=q, meta=meta, mueller=kind,
+                       mueller_basis=basis, **arrays)
 
 
 def _clean(text: Any) -> str:
@@ -389,6 +439,8 @@ def _header_from_csv(meta: dict[str, Any], unit: str, quantity: str) -> list[str
     seen = set()
     for key, val in meta["header"].items():
         k = key.lower()
+        if k in _MUELLER_KEYS:  # written from the measurement's attributes (_header)
+            continue
         seen.add(k)
         if k in _UNIT_KEYS:
             val = unit
@@ -417,6 +469,9 @@ def _header(m: Measurement, unit: str, orig_keys: list[str]) -> list[str]:
     else:
         head += [f"# angles: {unit}", f"# quantity: {quantity}"]
         head += [f"# {k}: {_clean(meta[k])}" for k in _PROVENANCE if meta.get(k)]
+    if m.mueller is not None:  # right after the quantity line (always written)
+        at = next(i for i, line in enumerate(head) if line.lower().startswith("# quantity:")) + 1
+        head[at:at] = [f"# mueller: {m.mueller}", f"# mueller_basis: {m.mueller_basis}"]
     present = {line[2:].partition(":")[0].strip().lower() for line in head}
     if meta.get("file") and "source_file" not in present:
         head.append(f"# source_file: {_clean(meta.get('source_file', meta['file']))}")
@@ -462,6 +517,9 @@ def write(measurement: Measurement, path: str | os.PathLike, *, angles: str = "d
         if "," in c or c.strip() != c or not c or c.lower() in reserved or \
                 c.startswith(("sigma_", "orig_")) or _SUFFIX.match(c.lower()):
             raise ValueError(f"channel label {c!r} cannot be a CSV column name")
+        if m.mueller is None and _ELEMENT.match(c):  # the reader would ask for '# mueller:'
+            raise ValueError(f"channel label {c!r} is a Mueller element name but the "
+                             "measurement declares no Mueller data (mueller=None)")
     names = ["theta_i", "theta_r", "phi", *m.channels]
     cols = [m.theta_i * factor, m.theta_r * factor, m.phi * factor, m.values]
     if m.uncertainty is not None:

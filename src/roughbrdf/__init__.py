@@ -83,8 +83,8 @@ _ATTRS = {
 #: ones of ``__all__`` and those an eager ``import roughbrdf`` used to load as a side effect
 _SUBMODULES = frozenset({
     "diffuse", "distributions", "export", "fresnel", "geometry", "shadowing", "fitting",
-    "integrate", "io", "measurement", "models", "polarization", "quantity", "registry",
-    "special",
+    "integrate", "io", "measurement", "models", "mueller", "plot_mueller", "polarization",
+    "quantity", "registry", "special", "stokes",
 })
 
 

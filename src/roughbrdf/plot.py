@@ -51,6 +51,8 @@ if TYPE_CHECKING:
 
 __all__ = [
     "new_axes",
+    "disk_decorations",
+    "hemisphere_grid",
     "incidence_colors",
     "model_values",
     "compared_values",
@@ -299,7 +301,7 @@ def plot_hemisphere(model: Model, theta_i: float, *, quantity: str = "brdf", log
     mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(Z), shading="auto", cmap=cmap, norm=norm,
                          rasterized=True)
     fig.colorbar(mesh, ax=ax, label=QUANTITY_LABELS.get(quantity, quantity), shrink=0.9)
-    _disk_decorations(ax)
+    disk_decorations(ax)
     s = math.sin(theta_i)
     ax.plot([s], [0], marker="+", ms=10, color="c", ls="none", label="specular")
     ax.plot([-s], [0], marker="x", ms=7, color="c", ls="none", label="source (retro)")
@@ -308,7 +310,9 @@ def plot_hemisphere(model: Model, theta_i: float, *, quantity: str = "brdf", log
     return fig, ax
 
 
-def _disk_decorations(ax: Axes) -> None:
+def disk_decorations(ax: Axes, *, labels: bool = True) -> None:
+    """Circles at theta_r = 30, 60, 90 deg, the plane of incidence, equal aspect and (with
+    ``labels``) the axis labels of a projected-disk map (:func:`hemisphere_grid`)."""
     t = np.linspace(0, 2 * math.pi, 361)
     for deg in (30, 60, 90):
         r = math.sin(math.radians(deg))
@@ -317,8 +321,9 @@ def _disk_decorations(ax: Axes) -> None:
     ax.set_aspect("equal")
     ax.set_xlim(-1.05, 1.05)
     ax.set_ylim(-1.05, 1.05)
-    ax.set_xlabel(r"$x = \sin\theta_r\cos\phi$ (forward $\rightarrow$)")
-    ax.set_ylabel(r"$y = \sin\theta_r\sin\phi$")
+    if labels:
+        ax.set_xlabel(r"$x = \sin\theta_r\cos\phi$ (forward $\rightarrow$)")
+        ax.set_ylabel(r"$y = \sin\theta_r\sin\phi$")
 
 
 # --------------------------------------------------------------------------------------------
@@ -528,7 +533,7 @@ def plot_residual_map(model: Model, measurement: Measurement, *, channel: int | 
     if sc is not None:
         fig.colorbar(sc, ax=ax, label="(data − model) / model", shrink=0.9,
                      extend="both" if clipped else "neither")
-    _disk_decorations(ax)
+    disk_decorations(ax)
     rms = float(np.sqrt(np.mean(res[ok] ** 2))) if ok.any() else float("nan")
     ax.set_title(f"{model.name}: relative residual [{meas.channels[0]}], r.m.s. {rms:.3g}",
                  fontsize="medium")

@@ -22,7 +22,7 @@ import typer
 
 from .common import degree_range, handled, parse_params
 
-KINDS = ("in-plane", "polar", "hemisphere")
+KINDS = ("in-plane", "polar", "hemisphere", "mueller", "mueller-plane", "dolp")
 
 #: the library's argument names -> this verb's options (errors name the options)
 OPTIONS = {"theta_i": "--theta-i", "elevation": "--elevation", "quantity": "--quantity",
@@ -64,6 +64,8 @@ def _model_figure(model_name: str, params: dict[str, Any], kind: str, theta_i: s
 
     m = _models.model(model_name, **params)
     ti = degree_range(theta_i, "--theta-i")
+    if kind in ("mueller", "mueller-plane", "dolp"):
+        return _polarimetric_figure(m, kind, ti)
     if kind == "in-plane":
         if np.any(ti >= 0.5 * math.pi):
             raise ValueError("--theta-i must be below 90 degrees")
@@ -74,6 +76,23 @@ def _model_figure(model_name: str, params: dict[str, Any], kind: str, theta_i: s
         return rbplot.plot_polar(m, float(ti[0]), math.radians(elevation), label=m.name)
     return rbplot.plot_hemisphere(m, float(ti[0]), quantity=quantity,
                                   log=True if log is None else log)
+
+
+def _polarimetric_figure(m: Any, kind: str, ti: Any):
+    """The Mueller-matrix and DoLP figures (:mod:`roughbrdf.plot_mueller`)."""
+    import numpy as np
+
+    from .. import plot_mueller
+
+    if np.any(ti >= 0.5 * math.pi):
+        raise ValueError("--theta-i must be below 90 degrees")
+    if kind == "mueller-plane":
+        return plot_mueller.plot_mueller_in_plane(m, ti)
+    if ti.size != 1:
+        raise ValueError(f"--kind {kind} takes one --theta-i, got {ti.size}")
+    if kind == "mueller":
+        return plot_mueller.plot_mueller_hemisphere(m, float(ti[0]))
+    return plot_mueller.plot_dolp(m, float(ti[0]))
 
 
 def _fit_aperture(fit: dict[str, Any]):
@@ -214,7 +233,9 @@ def register(app: typer.Typer) -> None:
             help="model name, e.g. trowbridge-reitz-1975")] = None,
         param: Annotated[list[str] | None, typer.Option(
             "-p", "--param", help="name=value (repeatable)")] = None,
-        kind: Annotated[str, typer.Option(help="in-plane, polar or hemisphere")] = "in-plane",
+        kind: Annotated[str, typer.Option(
+            help="in-plane, polar, hemisphere; mueller (16 elements over the hemisphere), "
+                 "mueller-plane (in the plane of incidence) or dolp")] = "in-plane",
         theta_i: Annotated[str, typer.Option(
             "--theta-i", help="incidence, DEG or START:STOP:STEP (one value for "
                               "polar/hemisphere)")] = "0:60:20",

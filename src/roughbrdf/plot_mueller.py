@@ -147,8 +147,11 @@ def plot_dolp(model: Model, theta_i: float, *, incident: ArrayLike | None = None
     X, Y, tr, ph = hemisphere_grid(n)
     inside = np.isfinite(tr)
     Z = np.full(X.shape, np.nan)
-    Z[inside] = dolp(reflected_stokes(model, theta_i, tr[inside], ph[inside], s_in,
-                                      basis=basis))
+    # a model that diverges at the horizon (TR75 has no shadowing: +-inf at theta_r = 90 deg)
+    # has no DoLP there: NaN, drawn blank, without NumPy's warning
+    with np.errstate(invalid="ignore"):
+        Z[inside] = dolp(reflected_stokes(model, theta_i, tr[inside], ph[inside], s_in,
+                                          basis=basis))
     mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(Z), shading="auto", cmap="viridis",
                          vmin=0.0, vmax=1.0, rasterized=True)
     fig.colorbar(mesh, ax=ax, label="degree of linear polarization", shrink=0.9)

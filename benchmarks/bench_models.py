@@ -147,6 +147,32 @@ def main() -> dict[str, float]:
     out["tr75-speedup"] = speedup
     for label, _ in calls:
         out[f"{label} / tr75"] = rates[label] / rates[ref_label]
+    out.update(mueller_rates(ti, tr, phi, rates[ref_label]))
+    return out
+
+
+def mueller_rates(ti: np.ndarray, tr: np.ndarray, phi: np.ndarray,
+                  tr75_rate: float) -> dict[str, float]:
+    """Mueller matrices per second (``model.mueller``, psps) on the same geometries,
+    interleaved; the ratio to TR75's scalar ``brdf()`` rate of the table above."""
+    models = {"trowbridge-reitz-1975": rb.model("trowbridge-reitz-1975", **TR75_PARAMS),
+              "microfacet (ggx, smith-hc, fresnel)": rb.model("microfacet"),
+              "coated (1 lobe)": rb.model("coated"), "lambertian": rb.model("lambertian")}
+    for m in models.values():  # warm-up: compile or load from the disk cache
+        m.mueller(ti[:10], tr[:10], phi[:10])
+    best = dict.fromkeys(models, math.inf)
+    for _ in range(5):
+        for label, m in models.items():
+            t0 = time.perf_counter()
+            m.mueller(ti, tr, phi)
+            best[label] = min(best[label], time.perf_counter() - t0)
+    print(f"\nMueller matrices (model.mueller, psps, {N:.0e} geometries, 4x4 float64 each; "
+          f"best of 5 interleaved rounds):")
+    out = {}
+    for label, t in best.items():
+        rate = N / t
+        out[f"mueller {label}"] = rate
+        print(f"  {label:<44} {rate:>10.3e} matrices/s  ({rate / tr75_rate:.3f} x TR75 brdf)")
     return out
 
 

@@ -271,7 +271,9 @@ class Model:
         polarization : Polarization, None, "unpolarized", "s", "p", float or array
             Incident polarization (:class:`~roughbrdf.polarization.Polarization`): TR75's angle
             ``gamma`` of the electric field from the plane of incidence (radians); arrays give
-            one polarization per sample.
+            one polarization per sample. ``Polarization(stokes=S, analyzer=a)`` gives an
+            incident Stokes vector and a detector row instead: the result is ``a · (M S)``
+            with ``M`` = :meth:`mueller` (``docs/polarization.md``).
         term : str, optional
             A single term of a model that has several (e.g. RB08 ``"surface"``), or a
             component of a sum by its prefix.

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING as _TYPE_CHECKING  # noqa: E402
 
 if _TYPE_CHECKING:  # for type checkers and IDEs; at run time the names load on first use
     from . import diffuse, distributions, fresnel, geometry, shadowing
+    from .catalogue import fit_catalogue
     from .export import export_mitsuba, export_to, export_zemax
     from .fitting import FitResult, compare, fit
     from .integrate import albedo, reciprocity_error
@@ -45,6 +46,7 @@ __all__ = [
     "export_to",
     "export_zemax",
     "fit",
+    "fit_catalogue",
     "FitResult",
     "fresnel",
     "geometry",
@@ -64,6 +66,7 @@ _ATTRS = {
     "FitResult": "fitting",
     "fit": "fitting",
     "compare": "fitting",
+    "fit_catalogue": "catalogue",
     "export_to": "export",
     "export_mitsuba": "export",
     "export_zemax": "export",
@@ -82,9 +85,9 @@ _ATTRS = {
 #: submodules reachable as attributes (``rb.geometry``) without importing them first: the public
 #: ones of ``__all__`` and those an eager ``import roughbrdf`` used to load as a side effect
 _SUBMODULES = frozenset({
-    "diffuse", "distributions", "export", "fresnel", "geometry", "shadowing", "fitting",
-    "integrate", "io", "measurement", "models", "mueller", "plot_mueller", "polarization",
-    "quantity", "registry", "special", "stokes",
+    "catalogue", "diffuse", "distributions", "export", "fresnel", "geometry", "shadowing",
+    "fitting", "integrate", "io", "measurement", "models", "mueller", "plot_mueller",
+    "polarization", "quantity", "registry", "special", "stokes",
 })
 
 

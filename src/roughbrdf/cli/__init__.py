@@ -42,7 +42,7 @@ EXIT_BUG = 4
 EXIT_INTERRUPTED = 130
 
 #: modules under roughbrdf.cli that register verbs (each defines register(app))
-VERBS = ["evaluate", "fit", "compare", "export", "convert", "plot", "reproduce"]
+VERBS = ["evaluate", "fit", "fit_batch", "compare", "export", "convert", "plot", "reproduce"]
 
 _APP: list[Any] = []
 

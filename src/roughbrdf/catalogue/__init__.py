@@ -1,0 +1,253 @@
+"""Catalogues: fit one model to many files on ``dask.distributed`` (``docs/catalogue.md``).
+
+:func:`fit_catalogue` runs one task per input file: a ``LocalCluster`` of worker processes on
+this machine by default (one thread each, BLAS single-threaded), or the same code on an existing
+cluster given by its scheduler address or a ``distributed.Client``. Each task reads its file,
+fits it exactly as :func:`roughbrdf.fit` would, and saves the usual fit folder
+(:meth:`roughbrdf.FitResult.save`'s files) as one all-or-nothing set; the rows of every file x
+channel (:mod:`~roughbrdf.catalogue.rows`) go into ``catalogue.csv`` and ``catalogue.json``.
+
+One job per module:
+
+=========================================  ===================================================
+:mod:`~roughbrdf.catalogue.rows`           the row schema, ``catalogue.csv`` / ``.json``
+:mod:`~roughbrdf.catalogue.tasks`          the function a worker runs for one file
+:mod:`~roughbrdf.catalogue.worker`         worker set-up: one BLAS thread, kernels warmed once
+:mod:`~roughbrdf.catalogue.resume`         input hash + model/options fingerprint, skipping
+:mod:`~roughbrdf.catalogue.run`            the cluster, the scheduling loop, progress, limits
+=========================================  ===================================================
+
+``dask`` and ``distributed`` are imported only when a catalogue runs.
+"""
+
+from __future__ import annotations
+
+import glob
+import os
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ..errors import ArgumentError
+from .resume import completed_rows, file_sha256, fingerprint
+from .tasks import Task
+
+__all__ = ["fit_catalogue", "CatalogueResult", "expand_inputs", "folder_names",
+           "CATALOGUE_FILES"]
+
+#: the catalogue's own files in its folder
+CATALOGUE_FILES = ("catalogue.csv", "catalogue.json")
+#: the files of the summary page (:mod:`roughbrdf.catalogue.summary`, when it exists)
+SUMMARY_FILES = ("summary.md", "summary.html")
+
+
+@dataclass
+class CatalogueResult:
+    """What :func:`fit_catalogue` returns.
+
+    Attributes
+    ----------
+    rows : list of dict
+        One per file x channel, in the order of the inputs (:mod:`~roughbrdf.catalogue.rows`).
+    out_dir : pathlib.Path
+        The catalogue folder.
+    written : list of pathlib.Path
+        ``catalogue.csv``, ``catalogue.json`` (and the summary's files, if any).
+    """
+
+    rows: list[dict[str, Any]]
+    out_dir: Path
+    written: list[Path] = field(default_factory=list)
+
+    @property
+    def failed(self) -> list[dict[str, Any]]:
+        """The rows whose status is ``"failed"``."""
+        return [r for r in self.rows if r["status"] == "failed"]
+
+    @property
+    def success(self) -> bool:
+        """No row failed or did not converge."""
+        return all(r["status"] in ("ok", "skipped (resume)") for r in self.rows)
+
+
+def expand_inputs(inputs: str | os.PathLike | Iterable[str | os.PathLike]) -> list[str]:
+    """Files from paths, folders (their files, sorted) and glob patterns, duplicates removed.
+
+    Examples
+    --------
+    >>> expand_inputs([])
+    Traceback (most recent call last):
+    ...
+    roughbrdf.errors.ArgumentError: no input files were given
+    """
+    given = [inputs] if isinstance(inputs, str | os.PathLike) else list(inputs)
+    items = [os.fspath(i) for i in given]
+    out: list[str] = []
+    for item in items:
+        if os.path.isdir(item):
+            found = sorted(str(p) for p in Path(item).iterdir()
+                           if p.is_file() and not p.name.startswith("."))
+        elif glob.has_magic(item):
+            found = sorted(p for p in glob.glob(item) if os.path.isfile(p))
+            if not found:
+                raise ArgumentError("inputs", "no file matches the pattern", value=item)
+        elif os.path.isfile(item):
+            found = [item]
+        else:
+            raise FileNotFoundError(2, "no such file", item)
+        out.extend(found)
+    if not out:
+        if not items:
+            raise ArgumentError("inputs", "no input files were given")
+        raise ArgumentError("inputs", "no input files found", value=", ".join(items))
+    unique: dict[str, str] = {}
+    for f in out:
+        unique.setdefault(os.path.abspath(f), f)
+    return list(unique.values())
+
+
+def folder_names(files: list[str]) -> list[str]:
+    """One fit folder name per file: its stem, made unique with ``-2``, ``-3`` ...
+
+    Examples
+    --------
+    >>> folder_names(["a/x.csv", "b/x.csv", "y.astm"])
+    ['x', 'x-2', 'y']
+    """
+    used: dict[str, int] = {}
+    names = []
+    for f in files:
+        stem = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in Path(f).stem)
+        stem = stem or "input"
+        used[stem] = used.get(stem, 0) + 1
+        names.append(stem if used[stem] == 1 else f"{stem}-{used[stem]}")
+    return names
+
+
+def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model: Any,
+                  out_dir: str | os.PathLike, *, client: Any = None,
+                  scheduler: str | None = None, n_workers: int | None = None,
+                  resume: bool = False, overwrite: bool = False, plots: bool = True,
+                  read_options: Mapping[str, Any] | None = None,
+                  candidates: Any = None, cv: bool = True, time_limit: float | None = None,
+                  retries: int = 1, progress: bool | None = None,
+                  **fit_options: Any) -> CatalogueResult:
+    """Fit ``model`` to every input file, one task per file, on ``dask.distributed``.
+
+    Parameters
+    ----------
+    inputs : path, folder, glob pattern, or a list of them
+        The measurement files (:func:`expand_inputs`).
+    model : Model or str
+        As for :func:`roughbrdf.fit` (``"auto"``: the lowest BIC of ``candidates``).
+    out_dir : path
+        The catalogue folder: one fit folder per input (named by :func:`folder_names`),
+        ``catalogue.csv`` and ``catalogue.json``.
+    client : distributed.Client, optional
+        Run on this client's cluster (it is left open).
+    scheduler : str, optional
+        Address of a running scheduler (``tcp://HOST:PORT``); not with ``client``.
+    n_workers : int, optional
+        Worker processes of the ``LocalCluster`` started when neither ``client`` nor
+        ``scheduler`` is given (default: the CPUs, at most one per file).
+    resume : bool
+        Skip the inputs whose fit folder holds complete results for the same input bytes,
+        model and options (:mod:`~roughbrdf.catalogue.resume`); redo the others, replacing
+        their earlier results, and replace the catalogue files.
+    overwrite : bool
+        Replace earlier results (the CLI's ``--force``); without it (or ``resume``) a folder
+        holding results stops the run before any work. Files roughbrdf did not write are never
+        replaced.
+    plots : bool
+        Write ``fit_<channel>.png`` in each fit folder.
+    read_options : mapping, optional
+        Passed to :func:`roughbrdf.read` (``format``, ``quantity``, ``angles``).
+    candidates, cv
+        With ``model="auto"``: as for :func:`roughbrdf.fitting.compare.fit_auto`.
+    time_limit : float, optional
+        Seconds one task may run; a task over it is reported failed and its worker restarted.
+    retries : int
+        How often a task is run again when its worker died under it.
+    progress : bool or None
+        Progress bar (files, channels, failures, ETA); None: on an interactive terminal.
+    **fit_options
+        Every option of :func:`roughbrdf.fit` (``fix``, ``bounds``, ``loss``, ``starts``, ...).
+
+    Returns
+    -------
+    CatalogueResult
+
+    Notes
+    -----
+    Ctrl-C cancels the tasks and closes a cluster this call started; every fit folder that was
+    finished is complete and no catalogue file is written.
+    """
+    from ..output import ResultFolder
+    from .run import run_tasks
+
+    if client is not None and scheduler is not None:
+        raise ArgumentError("scheduler", "give either a client or a scheduler address",
+                            value=scheduler)
+    files = expand_inputs(inputs)
+    out = Path(out_dir)
+    opts = {"fit": fit_options, "read": dict(read_options or {}), "plots": plots,
+            "candidates": candidates, "cv": cv}
+    fp = fingerprint(model, opts)
+    label = _label(model)
+    tasks, kept = [], {}
+    summary = _summary_module()
+    with ResultFolder(out, overwrite=overwrite or resume) as cat:
+        cat.check(CATALOGUE_FILES)
+        if summary is not None and not (overwrite or resume):
+            from ..output import refuse_existing
+
+            for name in SUMMARY_FILES:
+                refuse_existing(out / name, False)
+        for i, (f, name) in enumerate(zip(files, folder_names(files), strict=True)):
+            folder = out / name
+            rows = completed_rows(folder, file_sha256(f), fp) if resume else None
+            if rows is not None:
+                kept[i] = rows
+                continue
+            if not (overwrite or resume):
+                ResultFolder(folder).check([])
+            tasks.append((i, Task(file=f, path=os.path.abspath(f), folder=str(folder.resolve()),
+                                  fit_dir=name, model=model, fingerprint=fp, label=label,
+                                  fit_options=dict(fit_options), read_options=opts["read"],
+                                  candidates=candidates, cv=cv, plots=plots,
+                                  overwrite=overwrite or resume)))
+        done = run_tasks(tasks, model, client=client, scheduler=scheduler, n_workers=n_workers,
+                         time_limit=time_limit, retries=retries, progress=progress,
+                         skipped=sum(len(r) for r in kept.values()))
+        rows = [r for i in range(len(files)) for r in (kept.get(i) or done.get(i) or [])]
+        from .rows import csv_text, json_text
+
+        cat.add("catalogue.csv", csv_text(rows))
+        cat.add("catalogue.json", json_text(rows, model=label))
+    written = [out / n for n in CATALOGUE_FILES]
+    if summary is not None:
+        written += [Path(p) for p in summary.write_summary(out, rows,
+                                                           overwrite=overwrite or resume)]
+    return CatalogueResult(rows=rows, out_dir=out, written=written)
+
+
+def _label(model: Any) -> str:
+    """The model's label for the rows; an unknown model name fails here, before any work."""
+    if isinstance(model, str) and model.strip().lower() == "auto":
+        return "auto"
+    from ..fitting.setup import as_model, model_label
+
+    return model_label(as_model(model))
+
+
+def _summary_module() -> Any:
+    """:mod:`roughbrdf.catalogue.summary` (the summary page) if it exists, else None."""
+    import importlib
+
+    try:
+        return importlib.import_module(f"{__name__}.summary")
+    except ModuleNotFoundError as exc:
+        if exc.name != f"{__name__}.summary":
+            raise
+        return None

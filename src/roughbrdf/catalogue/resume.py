@@ -1,0 +1,71 @@
+"""``--resume``: which inputs already have complete results for the same input, model and options.
+
+Each per-file fit folder of a catalogue holds, besides the fit's own files, :data:`TASK_FILE`
+(written in the same all-or-nothing set, :class:`roughbrdf.output.ResultFolder`):
+``{"sha256": input hash, "fingerprint": model + options, "files": [...], "rows": [...]}``.
+An input is skipped when that file exists, its ``sha256`` and ``fingerprint`` equal the new
+run's, and every file it lists is in the folder and in the folder's manifest (a complete set).
+
+Examples
+--------
+>>> a = fingerprint("tr75", {"starts": 2, "seed": 0})
+>>> a == fingerprint("tr75", {"seed": 0, "starts": 2}), a == fingerprint("tr75", {"starts": 3})
+(True, False)
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+from typing import Any
+
+__all__ = ["TASK_FILE", "fingerprint", "file_sha256", "completed_rows"]
+
+#: the record of the catalogue task in each per-file folder
+TASK_FILE = "catalogue-task.json"
+
+
+def fingerprint(model: Any, options: dict[str, Any]) -> str:
+    """SHA-256 of the model (spec or ``Model.to_dict()``) and the options, key order ignored."""
+    spec = model.to_dict() if hasattr(model, "to_dict") else str(model)
+    text = json.dumps({"model": spec, "options": options}, sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def file_sha256(path: str | Path) -> str | None:
+    """SHA-256 of the file's bytes, None if it cannot be read."""
+    h = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
+    except OSError:
+        return None
+    return h.hexdigest()
+
+
+def completed_rows(folder: str | Path, sha256: str | None,
+                   fp: str) -> list[dict[str, Any]] | None:
+    """The rows of the complete earlier result in ``folder`` for this input and fingerprint,
+    marked ``"skipped (resume)"``; None if there is none (or it differs, or is incomplete)."""
+    from ..output import MANIFEST
+
+    folder = Path(folder)
+    if sha256 is None:
+        return None
+    try:
+        task = json.loads((folder / TASK_FILE).read_text(encoding="utf-8"))
+        listed = set(json.loads((folder / MANIFEST).read_text(encoding="utf-8")))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(task, dict) or task.get("sha256") != sha256 \
+            or task.get("fingerprint") != fp:
+        return None
+    files = [str(f) for f in task.get("files", [])]
+    if not all(f in listed and (folder / f).is_file() for f in [*files, TASK_FILE]):
+        return None
+    rows = task.get("rows")
+    if not isinstance(rows, list) or not rows:
+        return None
+    return [{**r, "status": "skipped (resume)"} for r in rows]

@@ -1,0 +1,254 @@
+"""Running catalogue tasks on ``dask.distributed``: the cluster, the loop, progress and limits.
+
+:func:`run_tasks` connects to the cluster (a ``Client`` given, a scheduler address, or a new
+``LocalCluster`` of single-threaded worker processes), registers
+:class:`~roughbrdf.catalogue.worker.WorkerSetup`, and keeps at most one task per worker thread
+in flight, so that a task's start is known (its per-task time limit counts from there). A task
+whose worker died is run again up to ``retries`` times; a task over the time limit is reported
+failed and its worker restarted. Ctrl-C cancels what is running and closes a cluster this
+module started; the fit folders of finished tasks are complete (each one is committed as a set
+on its worker), and unfinished ones keep no temporary files.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import time
+from collections import deque
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+from .rows import failed_row
+from .tasks import Task, run_task
+
+__all__ = ["run_tasks", "connect"]
+
+#: seconds between two looks at the running tasks (time limits, progress)
+POLL = 0.2
+
+
+@contextlib.contextmanager
+def connect(client: Any = None, scheduler: str | None = None,
+            n_workers: int | None = None, n_tasks: int = 1) -> Iterator[tuple[Any, bool]]:
+    """A ``distributed.Client``: ``client`` itself, one to ``scheduler``, or one to a new
+    ``LocalCluster`` (closed on exit); yields ``(client, local)`` (local: a cluster of ours)."""
+    if client is not None:
+        yield client, False
+        return
+    from distributed import Client
+
+    if scheduler is not None:
+        with Client(scheduler, timeout="20s") as c:
+            yield c, False
+        return
+    from distributed import LocalCluster
+
+    from .worker import WORKER_ENV
+
+    if n_workers is not None and (not isinstance(n_workers, int) or n_workers < 1):
+        from ..errors import ArgumentError
+
+        raise ArgumentError("n_workers", "must be a whole number >= 1", value=n_workers)
+    n = n_workers or max(1, min(os.cpu_count() or 1, n_tasks))
+    import dask
+
+    spawn = {**dask.config.get("distributed.nanny.pre-spawn-environ", {}), **WORKER_ENV}
+    # distributed's nannies apply pre-spawn-environ to *this* process's os.environ before they
+    # spawn a worker and leave it there: NUMBA_NUM_THREADS=1 would stay set for the caller
+    # (and a later Numba parallel loop raise "Cannot set NUMBA_NUM_THREADS to a different
+    # value"); the caller's environment is put back once the workers are up and at the end
+    saved = {k: os.environ.get(k) for k in spawn}
+    try:
+        # the workers' own log lines (e.g. tasks cancelled by Ctrl-C) are not the user's
+        # business
+        with dask.config.set({"distributed.nanny.pre-spawn-environ": spawn,
+                              "logging.distributed": "error"}):
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                   dashboard_address=None, env=WORKER_ENV)
+        _restore_environ(saved)
+        try:
+            with Client(cluster) as c:
+                yield c, True
+        finally:
+            cluster.close()
+    finally:
+        _restore_environ(saved)
+
+
+def _restore_environ(saved: dict[str, str | None]) -> None:
+    """Put the environment variables ``saved`` back as they were (None: unset)."""
+    for key, value in saved.items():
+        if value is None:
+            os.environ.pop(key, None)
+        else:
+            os.environ[key] = value
+
+
+def run_tasks(tasks: list[tuple[int, Task]], model: Any, *, client: Any = None,
+              scheduler: str | None = None, n_workers: int | None = None,
+              time_limit: float | None = None, retries: int = 1, progress: bool | None = None,
+              skipped: int = 0) -> dict[int, list[dict[str, Any]]]:
+    """Run ``tasks`` (``(index, Task)``); returns ``{index: rows}``."""
+    if not tasks:
+        return {}
+    if time_limit is not None and not time_limit > 0:
+        from ..errors import ArgumentError
+
+        raise ArgumentError("time_limit", "must be a number of seconds > 0", value=time_limit)
+    from .worker import WorkerSetup
+
+    loop = _Loop(tasks, time_limit, retries, _bar(progress, len(tasks), skipped))
+    try:
+        with connect(client, scheduler, n_workers, len(tasks)) as (c, local):
+            loop.local = local
+            c.register_plugin(WorkerSetup(model, local=local))
+            loop.run(c)
+    finally:
+        loop.close()
+    return loop.done
+
+
+class _Loop:
+    """The scheduling loop of :func:`run_tasks` (state: queued, running, done)."""
+
+    def __init__(self, tasks: list[tuple[int, Task]], time_limit: float | None, retries: int,
+                 bar: Any) -> None:
+        self.queue = deque(tasks)
+        self.tries = {i: 0 for i, _ in tasks}
+        self.running: dict[Any, tuple[int, Task, float]] = {}
+        self.done: dict[int, list[dict[str, Any]]] = {}
+        self.time_limit, self.retries, self.bar = time_limit, retries, bar
+        self.channels = self.failures = 0
+        self.local = False
+        self.unfinished: list[Task] = []
+
+    def run(self, client: Any) -> None:
+        from distributed import wait
+
+        slots = max(1, sum(client.nthreads().values()))
+        try:
+            while self.queue or self.running:
+                while self.queue and len(self.running) < slots:
+                    i, task = self.queue.popleft()
+                    fut = client.submit(run_task, task, key=f"roughbrdf-fit-{i}-"
+                                        f"{self.tries[i]}-{task.fingerprint[:8]}", pure=False)
+                    self.running[fut] = (i, task, time.monotonic())
+                with contextlib.suppress(TimeoutError):
+                    wait(list(self.running), timeout=POLL, return_when="FIRST_COMPLETED")
+                for fut in [f for f in self.running if f.done()]:
+                    self._finished(fut)
+                self._over_time(client)
+        except BaseException:
+            self._cancel(client)
+            raise
+
+    def _finished(self, fut: Any) -> None:
+        i, task, _ = self.running.pop(fut)
+        if fut.status == "finished":
+            self._record(i, fut.result())
+            return
+        exc = fut.exception()
+        self.tries[i] += 1
+        if self.tries[i] <= self.retries:  # the worker died under it (or the task broke)
+            self.queue.appendleft((i, task))
+            return
+        self._record(i, [failed_row(task.file, task.label, f"{type(exc).__name__}: {exc}",
+                                    sha256=None)])
+
+    def _over_time(self, client: Any) -> None:
+        if self.time_limit is None:
+            return
+        now = time.monotonic()
+        late = [f for f, (_, _, t0) in self.running.items() if now - t0 > self.time_limit]
+        if not late:
+            return
+        where = _workers_of(client, late)
+        for fut in late:
+            i, task, t0 = self.running.pop(fut)
+            fut.cancel()
+            self._record(i, [failed_row(task.file, task.label,
+                                        f"time limit of {self.time_limit:g} s exceeded",
+                                        sha256=None, elapsed_s=now - t0)])
+        if where:
+            with contextlib.suppress(Exception):  # a worker without a nanny cannot restart
+                client.restart_workers(sorted(where), timeout=30, raise_for_error=False)
+
+    def _record(self, i: int, rows: list[dict[str, Any]]) -> None:
+        self.done[i] = rows
+        self.channels += sum(1 for r in rows if r["channel"] is not None)
+        self.failures += any(r["status"] == "failed" for r in rows)
+        if self.bar is not None:
+            self.bar.set_postfix_str(f"channels {self.channels}, failed {self.failures}")
+            self.bar.update(1)
+
+    def _cancel(self, client: Any) -> None:
+        """Stop the running tasks (Ctrl-C or an error); their folders keep no stray files."""
+        futs = list(self.running)
+        with contextlib.suppress(Exception):
+            client.cancel(futs, force=True)
+        self.unfinished = [task for _, task, _ in self.running.values()]
+        self.running.clear()
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+        if self.local:
+            for task in self.unfinished:
+                tidy(task.folder)
+
+
+def _workers_of(client: Any, futures: list[Any]) -> set[str]:
+    keys = {f.key for f in futures}
+    with contextlib.suppress(Exception):
+        return {w for w, ks in client.processing().items() if keys & set(ks)}
+    return set()
+
+
+def tidy(folder: str | os.PathLike) -> None:
+    """Remove the temporary files and the lock that a killed task left in its fit folder
+    (only those of processes that no longer exist on this machine)."""
+    from ..output import LOCK, TMP_PREFIX
+
+    path = Path(folder)
+    lock = path / LOCK
+    try:
+        pid = int(lock.read_text().split()[0])
+    except (OSError, ValueError, IndexError):
+        pid = None
+    if pid is not None and _alive(pid):
+        return
+    for p in path.glob(f"{TMP_PREFIX}*") if path.is_dir() else []:
+        with contextlib.suppress(OSError):
+            p.unlink()
+    if pid is not None:
+        with contextlib.suppress(OSError):
+            lock.unlink()
+    with contextlib.suppress(OSError):
+        path.rmdir()  # only if empty: a folder the task had just created
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True
+    return True
+
+
+def _bar(progress: bool | None, total: int, skipped: int) -> Any:
+    """A tqdm bar over files (postfix: channels done, failures; tqdm shows the ETA)."""
+    import sys
+
+    show = sys.stderr.isatty() if progress is None else progress
+    if not show:
+        return None
+    from tqdm.auto import tqdm
+
+    desc = "fit-batch" + (f" ({skipped} channels kept)" if skipped else "")
+    return tqdm(total=total, desc=desc, unit="file", file=sys.stderr)

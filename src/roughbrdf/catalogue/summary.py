@@ -1,0 +1,470 @@
+"""The summary page of a catalogue fit: ``summary.md`` and a self-contained ``summary.html``.
+
+:func:`write_summary` takes the rows of a catalogue fit (one dict per file x channel, the
+schema below) and writes, in the catalogue folder:
+
+* ``summary.md``: the counts by status, the failures with their errors, a table of the first
+  rows with links to their fit folders, and a link to the HTML page;
+* ``summary.html``: one file with its CSS and JavaScript inline and the rows embedded as JSON
+  (column-wise, repeated strings stored once): a sortable (click a header; numbers sort as
+  numbers, text as text), filterable, paged table that draws only the current page (100,000
+  rows stay responsive), a contact sheet of at most ``max_thumbnails`` evenly sampled fit
+  figures each linking to its fit folder, and a histogram (inline SVG) of every fitted
+  parameter and of the residual across the catalogue.
+
+The thumbnails are the per-fit PNGs referenced by relative path, not embedded: the page lives
+in the catalogue folder beside them, and embedding 60 figures as data URIs would add several
+megabytes to a page that must stay small at 100,000 rows. The page fetches nothing else.
+
+Row schema: ``file``, ``channel``, ``model``, ``status`` (``"ok"``, ``"not converged"``,
+``"failed"``, ``"skipped (resume)"``), ``error`` (str or None), ``params`` and ``stderr``
+({name: value}), ``sigma``, ``rms_log``, ``aic``, ``bic``, ``n_points``, ``n_excluded``,
+``elapsed_s``, ``sha256``, ``fit_dir`` (relative to the catalogue folder) and ``figure``
+(relative path of the fit's PNG, or None). Missing keys count as None.
+
+Examples
+--------
+>>> import pathlib, tempfile
+>>> d = pathlib.Path(tempfile.mkdtemp())
+>>> rows = [{"file": "a.astm", "channel": "550nm", "model": "lambertian", "status": "ok",
+...          "params": {"rho": 0.4}, "rms_log": 0.05, "fit_dir": "a/550nm"}]
+>>> [p.name for p in write_summary(d, rows)]
+['summary.md', 'summary.html']
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import math
+import os
+from collections import Counter
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+from urllib.parse import quote, urlsplit
+
+import numpy as np
+
+from ..output import atomic_write, ensure_folder, refuse_existing
+
+__all__ = ["write_summary", "STATUSES"]
+
+#: the statuses of a row, in the order the counts list them
+STATUSES = ("ok", "not converged", "failed", "skipped (resume)")
+
+#: table columns before the parameters: (key, label, type)
+_FIXED = (("file", "file", "text"), ("channel", "channel", "text"), ("model", "model", "text"),
+          ("status", "status", "text"), ("n_points", "points", "num"),
+          ("n_excluded", "excluded", "num"), ("sigma", "sigma", "num"),
+          ("rms_log", "rms log", "num"), ("aic", "AIC", "num"), ("bic", "BIC", "num"),
+          ("elapsed_s", "time s", "num"))
+#: failures listed by name (the rest are counted; the HTML table's filter finds them)
+_MAX_FAILURES = 100
+#: columns stored once per distinct value (index into a list) in the page's JSON
+_CATEGORICAL = ("file", "channel", "model", "status")
+
+
+# --------------------------------------------------------------------------------------------
+# helpers
+# --------------------------------------------------------------------------------------------
+
+def _num(value: Any) -> float | int | None:
+    """A finite number (6 significant digits for floats), or None."""
+    if value is None or isinstance(value, bool):
+        return None
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        return None
+    if not math.isfinite(x):
+        return None
+    if isinstance(value, int | np.integer):
+        return int(value)
+    return float(f"{x:.6g}")
+
+
+def _href(path: Any) -> str | None:
+    """A relative path as a URL (percent-encoded); None for absolute paths or other schemes."""
+    if not path:
+        return None
+    text = str(path).replace(os.sep, "/")
+    if urlsplit(text).scheme or text.startswith("/"):
+        return None
+    return quote(text, safe="/")
+
+
+def _md_cell(value: Any) -> str:
+    """``value`` for a Markdown table cell: HTML-escaped, pipes and line breaks neutralized."""
+    text = "" if value is None else str(value)
+    return html.escape(" ".join(text.split())).replace("|", "\\|")
+
+
+def _fmt(value: Any) -> str:
+    x = _num(value)
+    if x is None:
+        return ""
+    return str(x) if isinstance(x, int) else f"{x:.4g}"
+
+
+def _param_names(rows: Sequence[Mapping[str, Any]]) -> list[str]:
+    """Every parameter name, in the order first seen."""
+    names: dict[str, None] = {}
+    for row in rows:
+        for name in row.get("params") or {}:
+            names.setdefault(str(name), None)
+    return list(names)
+
+
+def _sample(n: int, k: int) -> list[int]:
+    """``min(n, k)`` indices spread evenly over ``range(n)`` (first and last included)."""
+    if k <= 0 or n <= 0:
+        return []
+    if n <= k:
+        return list(range(n))
+    return sorted({int(round(i)) for i in np.linspace(0, n - 1, k)})
+
+
+# --------------------------------------------------------------------------------------------
+# the data embedded in the page
+# --------------------------------------------------------------------------------------------
+
+def _columns(params: list[str]) -> list[dict[str, str]]:
+    cols = [{"key": k, "label": lab, "type": t} for k, lab, t in _FIXED]
+    cols += [{"key": "p:" + p, "label": p, "type": "num"} for p in params]
+    cols.append({"key": "error", "label": "error", "type": "text"})
+    return cols
+
+
+def _table_data(rows: Sequence[Mapping[str, Any]], params: list[str]) -> dict[str, Any]:
+    """The rows column-wise: categorical columns as indices into ``dicts``."""
+    cols = _columns(params)
+    dicts: dict[str, dict[str, int]] = {k: {} for k in _CATEGORICAL}
+    data: list[list[Any]] = [[] for _ in cols]
+    links: list[str | None] = []
+    for row in rows:
+        values = row.get("params") or {}
+        for j, col in enumerate(cols):
+            key = col["key"]
+            if key in dicts:
+                text = "" if row.get(key) is None else str(row.get(key))
+                data[j].append(dicts[key].setdefault(text, len(dicts[key])))
+            elif key.startswith("p:"):
+                data[j].append(_num(values.get(key[2:])))
+            elif col["type"] == "num":
+                data[j].append(_num(row.get(key)))
+            else:
+                data[j].append(None if row.get(key) is None else str(row.get(key)))
+        links.append(_href(row.get("fit_dir")))
+    return {"columns": cols, "data": data, "links": links,
+            "dicts": {k: list(v) for k, v in dicts.items()}}
+
+
+def _json_for_script(obj: Any) -> str:
+    """JSON safe inside ``<script type="application/json">`` (no ``<``, ``>`` or ``&``)."""
+    text = json.dumps(obj, separators=(",", ":"), ensure_ascii=False, allow_nan=False)
+    return (text.replace("&", "\\u0026").replace("<", "\\u003c").replace(">", "\\u003e")
+            .replace("\u2028", "\\u2028").replace("\u2029", "\\u2029"))
+
+
+# --------------------------------------------------------------------------------------------
+# plots and thumbnails (static HTML, drawn here)
+# --------------------------------------------------------------------------------------------
+
+def _histogram_svg(name: str, values: np.ndarray, bins: int = 30) -> str:
+    """An inline SVG histogram of ``values`` (log10 axis when they span over two decades)."""
+    w, h, pad = 260, 150, 24
+    log = bool(np.all(values > 0) and values.max() / values.min() > 100)
+    x = np.log10(values) if log else values
+    lo, hi = float(x.min()), float(x.max())
+    if hi <= lo:
+        lo, hi = lo - 0.5, hi + 0.5
+    counts, edges = np.histogram(x, bins=bins, range=(lo, hi))
+    top = max(int(counts.max()), 1)
+    bar_w = (w - 2 * pad) / bins
+    bars = "".join(
+        f'<rect x="{pad + i * bar_w:.1f}" y="{h - pad - c / top * (h - 2 * pad):.1f}" '
+        f'width="{max(bar_w - 1, 0.5):.1f}" height="{c / top * (h - 2 * pad):.1f}">'
+        f'<title>{edges[i]:.4g} to {edges[i + 1]:.4g}: {c}</title></rect>'
+        for i, c in enumerate(counts) if c)
+    label = html.escape(("log10 " if log else "") + name)
+    return (f'<figure class="plot"><svg viewBox="0 0 {w} {h}" width="{w}" height="{h}" '
+            f'role="img" aria-label="histogram of {label}">{bars}'
+            f'<line x1="{pad}" y1="{h - pad}" x2="{w - pad}" y2="{h - pad}" class="axis"/>'
+            f'<text x="{pad}" y="{h - 8}">{lo:.3g}</text>'
+            f'<text x="{w - pad}" y="{h - 8}" text-anchor="end">{hi:.3g}</text>'
+            f'<text x="{pad}" y="14">max {top}</text></svg>'
+            f'<figcaption>{label} (n = {values.size})</figcaption></figure>')
+
+
+def _plots_html(rows: Sequence[Mapping[str, Any]], params: list[str]) -> str:
+    """Histograms of every parameter and of ``rms_log`` over the fitted (ok) rows."""
+    fitted = [r for r in rows if r.get("status") in ("ok", "not converged")]
+    series: list[tuple[str, list[Any]]] = [
+        (p, [(r.get("params") or {}).get(p) for r in fitted]) for p in params]
+    series.append(("rms_log", [r.get("rms_log") for r in fitted]))
+    parts = []
+    for name, raw in series:
+        vals = np.array([v for v in map(_num, raw) if v is not None], dtype=float)
+        if vals.size:
+            parts.append(_histogram_svg(name, vals))
+    if not parts:
+        return "<p>No fitted parameters to plot.</p>"
+    return '<div class="plots">' + "".join(parts) + "</div>"
+
+
+def _thumbnails_html(rows: Sequence[Mapping[str, Any]], max_thumbnails: int) -> str:
+    """The contact sheet: evenly sampled fit figures, each linking to its fit folder."""
+    with_fig = [r for r in rows if _href(r.get("figure"))]
+    chosen = [with_fig[i] for i in _sample(len(with_fig), max_thumbnails)]
+    if not chosen:
+        return "<p>No fit figures.</p>"
+    cards = []
+    for r in chosen:
+        src = html.escape(_href(r.get("figure")) or "")
+        link = html.escape(_href(r.get("fit_dir")) or src)
+        caption = html.escape(f"{r.get('file', '')} · {r.get('channel', '')}")
+        cards.append(f'<a class="thumb" href="{link}"><img src="{src}" alt="{caption}" '
+                     f'width="240"><span>{caption}</span></a>')
+    note = (f"<p>{len(chosen)} of {len(with_fig)} figures, evenly sampled.</p>"
+            if len(chosen) < len(with_fig) else "")
+    return note + '<div class="sheet">' + "".join(cards) + "</div>"
+
+
+# --------------------------------------------------------------------------------------------
+# the page
+# --------------------------------------------------------------------------------------------
+
+_CSS = """
+body{font:14px/1.4 system-ui,sans-serif;margin:1.5em;color:#222}
+h1{font-size:1.4em}h2{font-size:1.15em;margin-top:1.5em}
+table{border-collapse:collapse;font-size:13px}
+th,td{border:1px solid #ccc;padding:2px 6px;white-space:nowrap}
+td.num{text-align:right;font-variant-numeric:tabular-nums}
+td.err{white-space:normal;max-width:30em;color:#a00}
+th{background:#eee;cursor:pointer;user-select:none;position:sticky;top:0}
+th[aria-sort=ascending]::after{content:" \\25B2"}th[aria-sort=descending]::after{content:" \\25BC"}
+tr.st-failed td{background:#fde8e8}tr.st-not-converged td{background:#fff6dc}
+tr.st-skipped td{color:#777}
+#controls{margin:.5em 0;display:flex;gap:.6em;align-items:center;flex-wrap:wrap}
+.counts td:first-child{font-weight:bold}
+.plots,.sheet{display:flex;flex-wrap:wrap;gap:12px}
+.plot{margin:0}.plot svg{background:#fafafa;border:1px solid #ddd}
+.plot rect{fill:#4878a8}.plot text{font-size:10px;fill:#444}.plot .axis{stroke:#888}
+.plot figcaption{font-size:12px;text-align:center}
+.thumb{display:flex;flex-direction:column;width:240px;font-size:11px;color:#333;
+ text-decoration:none;border:1px solid #ddd;padding:2px}
+.thumb img{width:240px;height:auto}
+"""
+
+_JS = r"""
+(function () {
+  "use strict";
+  var D = JSON.parse(document.getElementById("rb-data").textContent);
+  var cols = D.columns, n = D.links.length, size = D.pageSize;
+  var data = cols.map(function (c, j) {
+    var dict = D.dicts[c.key], col = D.data[j];
+    return dict ? col.map(function (i) { return dict[i]; }) : col;
+  });
+  var statusCol = data[cols.findIndex(function (c) { return c.key === "status"; })];
+  var view = [], page = 0, sortCol = -1, dir = 1, search = null;
+  var collator = new Intl.Collator(undefined, {numeric: true, sensitivity: "base"});
+  var thead = document.querySelector("#rb-table thead tr");
+  var tbody = document.querySelector("#rb-table tbody");
+  var info = document.getElementById("rb-info");
+  var missing = function (v) { return v === null || v === undefined || v === ""; };
+
+  function compare(a, b) {
+    var x = data[sortCol][a], y = data[sortCol][b];
+    if (missing(x)) { return missing(y) ? a - b : 1; }
+    if (missing(y)) { return -1; }
+    var c = cols[sortCol].type === "num" ? x - y : collator.compare(x, y);
+    return c ? c * dir : a - b;
+  }
+  function applySort() { if (sortCol >= 0) { view.sort(compare); } }
+  function applyFilter(q) {
+    q = q.trim().toLowerCase();
+    view = [];
+    if (q && !search) {
+      search = new Array(n);
+      for (var i = 0; i < n; i++) {
+        search[i] = data.map(function (col) { return missing(col[i]) ? "" : col[i]; })
+          .join(" ").toLowerCase();
+      }
+    }
+    for (var k = 0; k < n; k++) { if (!q || search[k].indexOf(q) >= 0) { view.push(k); } }
+    applySort();
+    page = 0;
+  }
+  function fmt(v, type) {
+    if (missing(v)) { return ""; }
+    if (type === "num" && !Number.isInteger(v)) {
+      var a = Math.abs(v);
+      return a && (a < 1e-3 || a >= 1e6) ? v.toExponential(3) : Number(v.toPrecision(4)).toString();
+    }
+    return String(v);
+  }
+  function render() {
+    var pages = Math.max(1, Math.ceil(view.length / size));
+    page = Math.min(Math.max(page, 0), pages - 1);
+    var start = page * size, stop = Math.min(view.length, start + size);
+    var frag = document.createDocumentFragment();
+    for (var i = start; i < stop; i++) {
+      var r = view[i], tr = document.createElement("tr");
+      tr.className = "st-" + String(statusCol[r]).split(" ")[0].replace("not", "not-converged");
+      cols.forEach(function (c, j) {
+        var td = document.createElement("td"), v = data[j][r];
+        td.className = c.type === "num" ? "num" : (c.key === "error" ? "err" : "");
+        if (c.key === "file" && D.links[r]) {
+          var a = document.createElement("a");
+          a.href = D.links[r]; a.textContent = fmt(v, c.type); td.appendChild(a);
+        } else { td.textContent = fmt(v, c.type); }
+        tr.appendChild(td);
+      });
+      frag.appendChild(tr);
+    }
+    tbody.textContent = "";
+    tbody.appendChild(frag);
+    info.textContent = view.length ? "rows " + (start + 1) + "\u2013" + stop + " of " +
+      view.length + " (page " + (page + 1) + " of " + pages + ")" : "no rows";
+    document.getElementById("rb-prev").disabled = page === 0;
+    document.getElementById("rb-next").disabled = page >= pages - 1;
+  }
+  cols.forEach(function (c, j) {
+    var th = document.createElement("th");
+    th.textContent = c.label; th.dataset.key = c.key; th.title = "sort by " + c.label;
+    th.addEventListener("click", function () {
+      if (sortCol === j) { dir = -dir; } else { sortCol = j; dir = 1; }
+      Array.prototype.forEach.call(thead.children, function (h) {
+        h.removeAttribute("aria-sort");
+      });
+      th.setAttribute("aria-sort", dir > 0 ? "ascending" : "descending");
+      applySort(); page = 0; render();
+    });
+    thead.appendChild(th);
+  });
+  document.getElementById("rb-prev").addEventListener("click", function () { page--; render(); });
+  document.getElementById("rb-next").addEventListener("click", function () { page++; render(); });
+  document.getElementById("rb-filter").addEventListener("input", function (e) {
+    applyFilter(e.target.value); render();
+  });
+  applyFilter("");
+  render();
+  document.body.dataset.ready = "1";
+})();
+"""
+
+
+def _counts(rows: Sequence[Mapping[str, Any]]) -> list[tuple[str, int]]:
+    """(status, count) for the known statuses, then any other status seen."""
+    counts = Counter(str(r.get("status")) for r in rows)
+    order = [s for s in STATUSES] + sorted(s for s in counts if s not in STATUSES)
+    return [(s, counts[s]) for s in order if counts[s] or s in STATUSES]
+
+
+def _failures(rows: Sequence[Mapping[str, Any]]) -> list[Mapping[str, Any]]:
+    return [r for r in rows if r.get("status") == "failed" or r.get("error")]
+
+
+def _html_page(rows: Sequence[Mapping[str, Any]], title: str, page_size: int,
+               max_thumbnails: int) -> str:
+    """The whole ``summary.html``."""
+    params = _param_names(rows)
+    data = _table_data(rows, params)
+    data["pageSize"] = max(1, int(page_size))
+    counts = "".join(f"<tr><td>{html.escape(s)}</td><td>{c}</td></tr>" for s, c in _counts(rows))
+    fails = _failures(rows)
+    fail_items = "".join(
+        f"<li><b>{html.escape(str(r.get('file')))}</b> · {html.escape(str(r.get('channel')))}: "
+        f"{html.escape(str(r.get('error') or r.get('status')))}</li>"
+        for r in fails[:_MAX_FAILURES])
+    more = (f"<li>… and {len(fails) - _MAX_FAILURES} more (filter the table)</li>"
+            if len(fails) > _MAX_FAILURES else "")
+    fail_html = f"<ul>{fail_items}{more}</ul>" if fails else "<p>None.</p>"
+    t = html.escape(title)
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<link rel="icon" href="data:,"><title>{t}</title><style>{_CSS}</style></head>
+<body><h1>{t}</h1>
+<p>{len(rows)} fits (file × channel); {len(params)} fitted parameters.</p>
+<table class="counts"><tbody>{counts}</tbody></table>
+<h2>Failures</h2>{fail_html}
+<h2>Fits</h2>
+<div id="controls"><input id="rb-filter" type="search" placeholder="filter rows…"
+ aria-label="filter rows"><button id="rb-prev" type="button">◀ previous</button>
+<button id="rb-next" type="button">next ▶</button><span id="rb-info"></span></div>
+<table id="rb-table"><thead><tr></tr></thead><tbody></tbody></table>
+<h2>Parameters across the catalogue</h2>{_plots_html(rows, params)}
+<h2>Contact sheet</h2>{_thumbnails_html(rows, max_thumbnails)}
+<script type="application/json" id="rb-data">{_json_for_script(data)}</script>
+<script>{_JS}</script>
+</body></html>
+"""
+
+
+def _markdown(rows: Sequence[Mapping[str, Any]], title: str, page_size: int) -> str:
+    """The whole ``summary.md``."""
+    params = _param_names(rows)
+    lines = [f"# {_md_cell(title)}", "",
+             f"{len(rows)} fits (file × channel). Sortable, filterable table, parameter plots and "
+             "contact sheet: [summary.html](summary.html).", "",
+             "| status | fits |", "|---|---:|"]
+    lines += [f"| {_md_cell(s)} | {c} |" for s, c in _counts(rows)]
+    lines += ["", "## Failures", ""]
+    fails = _failures(rows)
+    lines += [f"- **{_md_cell(r.get('file'))}** · {_md_cell(r.get('channel'))}: "
+              f"{_md_cell(r.get('error') or r.get('status'))}"
+              for r in fails[:_MAX_FAILURES]] or ["None."]
+    if len(fails) > _MAX_FAILURES:
+        lines.append(f"- … and {len(fails) - _MAX_FAILURES} more (filter the HTML table)")
+    shown = rows[:max(1, int(page_size))]
+    lines += ["", f"## Fits (first {len(shown)} of {len(rows)})", ""]
+    head = ["file", "channel", "model", "status", "rms log", "BIC", *params]
+    lines += ["| " + " | ".join(_md_cell(h) for h in head) + " |",
+              "|" + "---|" * 4 + "---:|" * (len(head) - 4)]
+    for r in shown:
+        name, link = _md_cell(r.get("file")), _href(r.get("fit_dir"))
+        cells = [f"[{name}]({link})" if link else name, _md_cell(r.get("channel")),
+                 _md_cell(r.get("model")), _md_cell(r.get("status")), _fmt(r.get("rms_log")),
+                 _fmt(r.get("bic")), *(_fmt((r.get("params") or {}).get(p)) for p in params)]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def write_summary(out_dir: str | os.PathLike, rows: Iterable[Mapping[str, Any]], *,
+                  title: str | None = None, page_size: int = 100, max_thumbnails: int = 60,
+                  overwrite: bool = False) -> list[Path]:
+    """Write ``summary.md`` and ``summary.html`` of a catalogue fit into ``out_dir``.
+
+    Parameters
+    ----------
+    out_dir : str or path-like
+        The catalogue folder (``fit_dir`` and ``figure`` of the rows are relative to it).
+    rows : iterable of mapping
+        One per file x channel, with the keys listed in the module docstring.
+    title : str, optional
+        The page's title (default: "Catalogue summary: <folder name>").
+    page_size : int
+        Rows per page of the HTML table, and rows in the Markdown table.
+    max_thumbnails : int
+        At most this many fit figures, evenly sampled, in the contact sheet.
+    overwrite : bool
+        Replace existing summary files (default: refuse with
+        :class:`roughbrdf.output.OverwriteRefused` before writing anything).
+
+    Returns
+    -------
+    list of pathlib.Path
+        ``[summary.md, summary.html]``.
+    """
+    folder = ensure_folder(out_dir)
+    md_path, html_path = folder / "summary.md", folder / "summary.html"
+    refuse_existing(md_path, overwrite)
+    refuse_existing(html_path, overwrite)
+    rows = list(rows)
+    title = title or f"Catalogue summary: {folder.resolve().name}"
+    page = _html_page(rows, title, page_size, max_thumbnails)
+    atomic_write(md_path, _markdown(rows, title, page_size), overwrite=overwrite)
+    atomic_write(html_path, page, overwrite=overwrite)
+    return [md_path, html_path]

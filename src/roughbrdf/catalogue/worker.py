@@ -1,0 +1,75 @@
+"""Worker set-up for catalogue fits: one BLAS thread, kernels loaded once per worker process.
+
+:class:`WorkerSetup` is a ``distributed`` worker plugin: when a worker joins (or the plugin is
+registered), it limits BLAS to one thread for the whole process (``threadpoolctl``; each worker
+runs one task at a time, the parallelism is across workers); on the workers of a
+``LocalCluster`` of ours it ignores SIGINT (Ctrl-C in a terminal reaches the whole process
+group; the client then cancels the tasks and closes the cluster); and it evaluates the model
+once on a few directions, so that its compiled kernels are loaded from Numba's cache (or
+compiled) once per worker process instead of in every task; the worker keeps them for every
+later task. :data:`WORKER_ENV` is the environment given to the worker processes of a
+``LocalCluster`` (thread pools of one thread: BLAS, OpenMP, Numba).
+
+This module imports ``distributed``: it is loaded only when a catalogue runs.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from distributed.diagnostics.plugin import WorkerPlugin
+
+__all__ = ["WorkerSetup", "WORKER_ENV", "warm"]
+
+#: environment of the LocalCluster's worker processes: one thread in every thread pool
+WORKER_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
+              "NUMBA_NUM_THREADS": "1", "DASK_LOGGING__DISTRIBUTED": "error"}
+
+
+def warm(model: Any) -> None:
+    """Load ``model``'s kernels (and the fitting code) into this process: one evaluation.
+
+    Examples
+    --------
+    >>> import roughbrdf as rb
+    >>> warm(rb.model("lambertian"))
+    >>> warm("auto")  # a name: only the fitting code is imported
+    """
+    import numpy as np
+
+    from .. import fitting  # noqa: F401  (SciPy and the fitting kernels, once)
+
+    if hasattr(model, "brdf"):
+        t = np.array([0.1, 0.5])
+        model.brdf(t, t, np.array([0.0, 3.0]))
+
+
+class WorkerSetup(WorkerPlugin):
+    """Set a worker process up for catalogue fits (see the module docstring)."""
+
+    name = "roughbrdf-catalogue-setup"
+
+    def __init__(self, model: Any, *, local: bool = False) -> None:
+        self.model = model
+        self.local = local
+        self._limits: Any = None
+
+    def setup(self, worker: Any) -> None:
+        from threadpoolctl import threadpool_limits
+
+        if self.local:  # Ctrl-C reaches the whole process group: the client stops the cluster
+            _ignore_sigint()
+        self._limits = threadpool_limits(limits=1, user_api="blas")
+        warm(self.model)
+
+
+def _ignore_sigint() -> None:
+    """Ignore SIGINT in this (worker) process, where that is possible."""
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread():
+        try:
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+        except (ValueError, OSError):
+            pass

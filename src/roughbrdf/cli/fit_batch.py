@@ -1,0 +1,180 @@
+"""``roughbrdf fit-batch PATH|GLOB ... --model SPEC --out DIR``: fit many files (a catalogue).
+
+One task per file on ``dask.distributed`` (:func:`roughbrdf.catalogue.fit_catalogue`): a
+``LocalCluster`` of ``--workers N`` single-threaded worker processes by default, or an existing
+cluster by ``--scheduler tcp://HOST:PORT``. Every option of ``roughbrdf fit`` applies to each
+file. DIR receives one fit folder per input (``fit.json``, ``report.txt``, the PNGs), and
+``catalogue.csv`` / ``catalogue.json`` with one row per file x channel. A folder holding
+results stops the command before any work unless ``--force`` (replace) or ``--resume`` (skip
+the inputs whose complete results exist for the same input bytes, model and options; redo the
+rest). ``--time-limit S`` fails a task that runs longer than S seconds.
+
+Exit status 1 when a file failed (its error is printed, the others are fitted) or a fit did not
+converge; 130 on Ctrl-C (finished fit folders are complete, no catalogue file is written).
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any
+
+import typer
+
+from .common import handled, parse_params
+from .fit import (
+    OPTIONS,
+    CvOption,
+    JointOption,
+    KeepExtrapolatedOption,
+    ModelsOption,
+    SharedOption,
+)
+
+#: the library's argument names -> this verb's options (errors name the options)
+BATCH_OPTIONS = {**OPTIONS, "n_workers": "--workers", "scheduler": "--scheduler",
+                 "time_limit": "--time-limit", "inputs": "PATH", "resume": "--resume"}
+
+
+def read_options(quantity: str | None, angles_in: str | None,
+                 file_format: str | None) -> dict[str, Any]:
+    """``--quantity``, ``--angles-in``, ``--format`` -> :func:`roughbrdf.read` options.
+
+    Examples
+    --------
+    >>> read_options("bridf", "deg", None)
+    {'quantity': 'bridf', 'angles': 'deg'}
+    """
+    from ..quantity import Quantity
+    from .fit import angle_unit
+
+    opts: dict[str, Any] = {}
+    if quantity:
+        opts["quantity"] = Quantity.parse(quantity, "--quantity").value
+    unit = angle_unit(angles_in)
+    if unit is not None:
+        opts["angles"] = unit
+    if file_format:
+        opts["format"] = file_format
+    return opts
+
+
+def run_batch(paths: list[str], model: str, out: str, *, param: list[str] | None,
+              fix: list[str] | None, bounds: list[str] | None, models: str | None, cv: bool,
+              workers: int | None, scheduler: str | None, resume: bool, force: bool,
+              plots: bool, quiet: bool, time_limit: float | None, aperture: float | None,
+              theta_r_max: float | None, source_exclusion: float | None,
+              read: dict[str, Any], **fit_options: Any) -> int:
+    """The work of ``roughbrdf fit-batch``; the exit status (0, or 1 if a file failed or a fit
+    did not converge). Options are checked before any cluster starts."""
+    from ..catalogue import fit_catalogue
+    from .fit import (
+        auto_options,
+        build_model,
+        check_aperture,
+        fit_domain,
+        parse_bounds,
+        resolve_names,
+        start_within,
+    )
+
+    if workers is not None and scheduler is not None:
+        raise ValueError("--workers sets the size of a local cluster; with --scheduler the "
+                         "cluster's own workers run the fits: give one of them")
+    if workers is not None and workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {workers}")
+    t_max, excl = fit_domain(theta_r_max, source_exclusion)
+    auto = model.strip().lower() == "auto"
+    auto_options(models, param, fix, bounds, auto)
+    m: Any = "auto"
+    if not auto:
+        given = parse_params(param)
+        m = build_model(model, given)
+        fit_options["fix"] = resolve_names(m, list(fix or []))
+        ranges = parse_bounds(m, bounds)
+        fit_options["bounds"] = ranges or None
+        m = start_within(m, ranges, given)
+    res = fit_catalogue(paths, m, out, scheduler=scheduler, n_workers=workers, resume=resume,
+                        overwrite=force, plots=plots, read_options=read, candidates=models,
+                        cv=cv, time_limit=time_limit, progress=None if not quiet else False,
+                        aperture=check_aperture(aperture), theta_r_max=t_max,
+                        source_exclusion=excl, **fit_options)
+    files = {r["file"] for r in res.rows}
+    for r in res.failed:
+        typer.echo(f"failed: {r['file']}: {r['error']}", err=True)
+    bad = {r["file"] for r in res.rows if r["status"] == "not converged"}
+    for f in sorted(bad):
+        typer.echo(f"not converged: {f}", err=True)
+    kept = sum(r["status"] == "skipped (resume)" for r in res.rows)
+    typer.echo(f"{len(files)} files, {len(res.rows)} rows ({len(res.failed)} failed, "
+               f"{kept} kept from an earlier run); wrote "
+               + ", ".join(str(p) for p in res.written))
+    return 0 if res.success else 1
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("fit-batch")
+    def fit_batch_cmd(
+        paths: Annotated[list[str], typer.Argument(
+            metavar="PATH...",
+            help="measurement files, folders or glob patterns (quoted: 'data/*.astm')")],
+        model: str = typer.Option(..., "--model", "-m", help="model name, spec or sum (as for "
+                                                             "roughbrdf fit); auto: lowest BIC"),
+        out: str = typer.Option(..., "--out", "-o", help="catalogue folder"),
+        workers: int = typer.Option(None, "--workers", help="worker processes of the local "
+                                                            "cluster (default: the CPUs)"),
+        scheduler: str = typer.Option(None, "--scheduler", metavar="tcp://HOST:PORT",
+                                      help="run on this dask scheduler's workers instead"),
+        resume: bool = typer.Option(False, "--resume", help="skip inputs whose complete results "
+                                    "exist for the same input, model and options"),
+        time_limit: float = typer.Option(None, "--time-limit", metavar="S",
+                                         help="seconds a file's task may run (default: none)"),
+        models: ModelsOption = None,
+        cv: CvOption = True,
+        joint: JointOption = False,
+        shared: SharedOption = None,
+        keep_extrapolated: KeepExtrapolatedOption = False,
+        param: Annotated[list[str] | None, typer.Option(
+            "-p", "--param", help="starting value or option, name=value (repeatable)")] = None,
+        fix: Annotated[list[str] | None, typer.Option(
+            "--fix", help="keep this parameter at its value (repeatable)")] = None,
+        bounds: Annotated[list[str] | None, typer.Option(
+            "--bounds", metavar="NAME=LOW:HIGH", help="search range of a parameter")] = None,
+        channel: Annotated[list[str] | None, typer.Option(
+            "--channel", "-c", help="channel label or index (repeatable; default: all)")] = None,
+        loss: str = typer.Option("relative", help="relative, log or absolute"),
+        starts: int = typer.Option(8, help="multistart points per channel"),
+        quantity: str = typer.Option(None, help="input: brdf, brdf_cos, bridf or relative"),
+        angles_in: str = typer.Option(None, "--angles-in", metavar="deg|rad",
+                                      help="input: angle unit of ASTM or CSV files"),
+        relative_to: str = typer.Option(None, "--relative-to", help="relative data: brdf or "
+                                                                    "bridf"),
+        file_format: str = typer.Option(None, "--format", help="input format (default: from "
+                                                               "the extension)"),
+        nonfinite: str = typer.Option("raise", help="non-finite values: raise or drop"),
+        negative: str = typer.Option("keep", help="negative values: keep, drop or clip"),
+        seed: int = typer.Option(0, help="seed of the Sobol starts and the subsample"),
+        free_scale: bool = typer.Option(None, "--free-scale/--no-free-scale",
+                                        help="fit a free scale K of the data"),
+        aperture: float = typer.Option(None, "--aperture", metavar="DEG",
+                                       help="instrument aperture half-angle (degrees)"),
+        theta_r_max: float = typer.Option(None, "--theta-r-max", metavar="DEG",
+                                          help="fit domain: leave out theta_r above DEG"),
+        source_exclusion: float = typer.Option(None, "--source-exclusion", metavar="DEG",
+                                               help="fit domain: leave out samples within DEG "
+                                                    "of the source direction"),
+        plots: bool = typer.Option(True, "--plots/--no-plots", help="write PNG plots"),
+        force: bool = typer.Option(False, "--force", help="replace earlier results in --out"),
+        quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress bar"),
+    ) -> None:
+        """Fit a model to many files on dask; one fit folder each, catalogue.csv/.json."""
+        with handled(BATCH_OPTIONS):
+            code = run_batch(
+                paths, model, out, param=param, fix=fix, bounds=bounds, models=models, cv=cv,
+                workers=workers, scheduler=scheduler, resume=resume, force=force, plots=plots,
+                quiet=quiet, time_limit=time_limit, aperture=aperture, theta_r_max=theta_r_max,
+                source_exclusion=source_exclusion,
+                read=read_options(quantity, angles_in, file_format), channel=channel,
+                loss=loss, starts=starts, seed=seed, free_scale=free_scale,
+                nonfinite=nonfinite, negative=negative, relative_to=relative_to, joint=joint,
+                shared=shared or None, extrapolated="keep" if keep_extrapolated else "drop")
+        if code:
+            raise typer.Exit(code)

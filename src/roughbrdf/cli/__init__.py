@@ -61,8 +61,8 @@ def build_app() -> typer.Typer:
     import typer
 
     new = typer.Typer(add_completion=False, no_args_is_help=True,
-                      help="roughbrdf: rough-surface BRDF models - evaluate, fit, reproduce, "
-                           "convert.")
+                      help="roughbrdf: rough-surface BRDF models - evaluate, fit (a file or "
+                           "a catalogue), compare, export, plot, convert, reproduce.")
 
     @new.callback()
     def _options(debug: bool = typer.Option(

@@ -39,7 +39,7 @@ from typing import IO, Any
 
 from .interrupts import held_interrupts, raise_if_interrupted
 
-__all__ = ["atomic_write", "staged", "same_file", "ensure_folder", "refuse_existing",
+__all__ = ["atomic_write", "staged", "same_file", "ensure_folder", "file_sha256", "refuse_existing",
            "ResultFolder", "OverwriteRefused", "MANIFEST", "LOCK", "TMP_PREFIX"]
 
 #: prefix of the temporary files (a leftover one, after a power cut, is recognizable)
@@ -205,6 +205,24 @@ def staged(path: str | os.PathLike, *, overwrite: bool = False, binary: bool = F
         if tmp is not None:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
+
+
+def file_sha256(path: str | os.PathLike) -> str | None:
+    """SHA-256 (hex) of a file's bytes, read in 1 MiB blocks; None if it cannot be read.
+
+    The one fingerprint of an input file: ``fit.json``'s ``file_sha256``, the catalogue's
+    ``--resume`` and ``roughbrdf plot --fit``'s "changed since the fit" all use it.
+    """
+    import hashlib
+
+    h = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
+    except OSError:
+        return None
+    return h.hexdigest()
 
 
 def refuse_existing(path: str | os.PathLike, overwrite: bool) -> None:

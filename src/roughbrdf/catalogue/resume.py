@@ -20,6 +20,8 @@ import json
 from pathlib import Path
 from typing import Any
 
+from ..output import file_sha256
+
 __all__ = ["TASK_FILE", "fingerprint", "file_sha256", "completed_rows"]
 
 #: the record of the catalogue task in each per-file folder
@@ -31,18 +33,6 @@ def fingerprint(model: Any, options: dict[str, Any]) -> str:
     spec = model.to_dict() if hasattr(model, "to_dict") else str(model)
     text = json.dumps({"model": spec, "options": options}, sort_keys=True, default=repr)
     return hashlib.sha256(text.encode()).hexdigest()
-
-
-def file_sha256(path: str | Path) -> str | None:
-    """SHA-256 of the file's bytes, None if it cannot be read."""
-    h = hashlib.sha256()
-    try:
-        with open(path, "rb") as fh:
-            for block in iter(lambda: fh.read(1 << 20), b""):
-                h.update(block)
-    except OSError:
-        return None
-    return h.hexdigest()
 
 
 def completed_rows(folder: str | Path, sha256: str | None,

@@ -12,7 +12,6 @@ the fit (``file_sha256``).
 from __future__ import annotations
 
 import errno
-import hashlib
 import math
 import re
 from pathlib import Path
@@ -105,14 +104,6 @@ def _fit_aperture(fit: dict[str, Any]):
     return Aperture.parse(ap["half_angle_rad"], ap.get("points", 19))
 
 
-def _sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
 def _input_file(fit: dict[str, Any], base: Path) -> tuple[Path, bool]:
     """The fit's measurement file and whether it has changed since the fit.
 
@@ -132,8 +123,10 @@ def _input_file(fit: dict[str, Any], base: Path) -> tuple[Path, bool]:
     digest = fit.get("file_sha256")
     if not digest:
         return found[0], False  # a fit.json of an older roughbrdf
+    from ..output import file_sha256
+
     for c in found:
-        if _sha256(c) == digest:
+        if file_sha256(c) == digest:
             return c, False
     return found[0], True
 

@@ -37,20 +37,19 @@ from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from ..errors import ArgumentError
-from ..instrument import APERTURE_POINTS, Aperture, aperture_average, aperture_stencil
+from ..instrument import APERTURE_POINTS, aperture_average, aperture_stencil
 from ..quantity import LOSSES
 from .compare import AUTO_CANDIDATES, ModelComparison, compare, fit_auto
-from .data import ChannelData, Comparison, DataOptions, prepare_channel
+from .data import ChannelData, prepare_channel
 from .joint import fit_joint
 from .objective import Objective, ObjectiveSpec
-from .result import ChannelFit, FitResult, input_source
+from .result import ChannelFit, FitResult
 from .search import MultiStart, SearchOptions, progress_bar
 from .setup import (
-    FreeParameters,
+    FitPlan,
     as_model,
     channel_indices,
     check_enough_data,
-    data_scale,
     model_label,
 )
 from .threads import single_thread_blas
@@ -218,16 +217,16 @@ def fit(model: Model | str, measurement: Measurement, *,
                         progress=progress)
     model = as_model(model)
     chans = channel_indices(measurement, channel)
-    ap = Aperture.parse(aperture, aperture_points)
-    opts = DataOptions(Comparison.of(measurement, relative_to), loss, weights, nonfinite,
-                       negative, ap, theta_r_max, source_exclusion, extrapolated)
-    search = SearchOptions(starts, screen, subsample, polish, max_nfev, seed)
-    k_free, k_fixed = data_scale(measurement, free_scale, scale)
-    params = FreeParameters.of(model, fix, bounds)
-    spec = params.spec(model, loss=loss, quantity=opts.comparison.quantity, free_scale=k_free,
-                       fixed_scale=k_fixed)
+    plan = FitPlan.of(model, measurement, loss=loss, weights=weights, fix=fix, bounds=bounds,
+                      starts=starts, seed=seed, nonfinite=nonfinite, negative=negative,
+                      relative_to=relative_to, free_scale=free_scale, scale=scale,
+                      screen=screen, subsample=subsample, polish=polish, max_nfev=max_nfev,
+                      aperture=aperture, aperture_points=aperture_points,
+                      theta_r_max=theta_r_max, source_exclusion=source_exclusion,
+                      extrapolated=extrapolated)
+    spec, search = plan.spec, plan.search
     # every channel first, so that bad input fails before any work
-    data = [prepare_channel(model, measurement, j, opts) for j in chans]
+    data = [prepare_channel(model, measurement, j, plan.opts) for j in chans]
     check_enough_data(measurement, data, spec.n_varys)
     if not isinstance(joint, bool):
         raise ArgumentError("joint", "must be True or False", value=joint)
@@ -243,24 +242,8 @@ def fit(model: Model | str, measurement: Measurement, *,
             results, summary = fit_joint(spec, data, search, shared, tick)
         else:
             results, summary = _separately(spec, search, data, bar, tick), None
-    options = {"starts": search.starts, "seed": seed, "subsample": subsample,
-               "polish": search.polish, "nonfinite": nonfinite, "negative": negative,
-               "free_scale": k_free, "scale": scale,
-               "aperture": None if ap is None else ap.half_angle,
-               "aperture_points": None if ap is None else ap.points,
-               "theta_r_max": opts.theta_r_max, "source_exclusion": opts.source_exclusion,
-               "extrapolated": extrapolated,
-               "joint": summary,
-               "fix": sorted(set(model.param_names) - set(params.names)),
-               "weights": None if weights is None else
-               (weights if isinstance(weights, str) else "array")}
-    return FitResult(channels=results, measurement=measurement, model_name=model_label(model),
-                     loss=loss, compared=opts.comparison.compared,
-                     relative_to=opts.comparison.relative_to, options=options,
-                     elapsed=time.perf_counter() - t_start,
-                     aperture=None if ap is None else ap.half_angle,
-                     aperture_points=19 if ap is None else ap.points,
-                     source=input_source(measurement))
+    return FitResult(channels=results, **plan.result_fields(
+        measurement, time.perf_counter() - t_start, joint=summary))
 
 
 def _separately(spec: ObjectiveSpec, search: SearchOptions, data: list[ChannelData],

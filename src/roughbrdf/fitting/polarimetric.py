@@ -36,15 +36,14 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import ArgumentError
-from ..instrument import Aperture, InstrumentGeometry
+from ..instrument import InstrumentGeometry
 from ..measurement import MUELLER_ELEMENTS, Measurement
 from ..quantity import Quantity
-from .data import Comparison, DataOptions, prepare_channel, where
+from .data import DataOptions, prepare_channel, where
 from .objective import BAD_RESIDUAL, Objective, ObjectiveSpec
-from .result import ChannelFit, FitResult, input_source
+from .result import ChannelFit, FitResult
 from .search import MultiStart, SearchOptions, SearchOutcome, progress_bar
-from .setup import FreeParameters, as_model, check_enough_data, data_scale, model_label
-from .statistics import Covariance, GoodnessOfFit, at_bound
+from .setup import FitPlan, as_model, check_enough_data, model_label
 from .threads import single_thread_blas
 
 if TYPE_CHECKING:
@@ -354,42 +353,19 @@ class MuellerChannelFit(ChannelFit):
     @classmethod
     def from_mueller_search(cls, obj: MuellerObjective, outcome: SearchOutcome,
                             elapsed: float) -> MuellerChannelFit:
-        """The result at the search's optimum, statistics on all residuals of ``obj``."""
-        spec, data, theta = obj.spec, obj.data, outcome.theta
-        fitted_model = spec.model_at(theta)
-        f = obj.values(theta)
-        k = obj.scale(f)
-        r = obj.residual_of(f, k)
-        gof = GoodnessOfFit.of(r, data.m00, f[:, 0], scale=k, n_varys=spec.n_varys,
-                               floor=obj.floor)
-        bound = at_bound(theta, spec.lower, spec.upper, spec.free)
-        cov = Covariance.at_optimum(obj, theta, f, k, chi2=gof.chi2, dof=gof.dof,
-                                    held=list(bound))
-        sd = cov.stderr()
-        stderr: dict[str, float | None] = dict.fromkeys(spec.model.param_names)
-        stderr.update({nm: float(s) for nm, s in zip(cov.names, sd, strict=True)
-                       if nm != "scale"})
-        res = outcome.result
-        message = (res.message.rstrip(".") if res is not None else "no local fit finished")
-        message += cov.note + (f"; at a bound: {', '.join(bound)}" if bound else "")
+        """The result at the search's optimum, statistics on all residuals of ``obj`` (the
+        figures of merit, sigma and rms-log, on m00)."""
+        data = obj.data
+        f = obj.values(outcome.theta)
+        fields = ChannelFit.fields_at_optimum(obj, outcome, elapsed, f, data.m00, f[:, 0])
+        r = fields["residual"]
         fn = obj.normalized_of(f)
         diff = fn - data.normalized
         rms = {nm: float(np.sqrt(np.mean(diff[:, c] ** 2)))
                for c, nm in enumerate(data.element_names)}
         rms["all"] = float(np.sqrt(np.mean(diff ** 2))) if diff.size else math.nan
         return cls(
-            channel=data.label, model=fitted_model, params=fitted_model.params,
-            free=list(spec.free), init=spec.start_values(),
-            bounds={nm: (float(a), float(b))
-                    for nm, a, b in zip(spec.free, spec.lower, spec.upper, strict=True)},
-            stderr=stderr, correl=cov.correl(), covar=cov.matrix, scale=float(k),
-            scale_stderr=float(sd[-1]) if spec.free_scale else 0.0,
-            success=bool(res.success) if res is not None else False, message=message,
-            sigma=gof.sigma, rms_log=gof.rms_log, chi2=gof.chi2, redchi=gof.redchi,
-            aic=gof.aic, bic=gof.bic, n_points=gof.n_points, n_varys=gof.n_varys,
-            excluded=data.excluded, nfev=obj.nfev + outcome.explore_nfev, starts=outcome.tried,
-            free_scale=spec.free_scale, at_bound=bound, elapsed=elapsed, index=data.index,
-            data=data.m00, fitted=f[:, 0], residual=r, elements=data.element_names,
+            **fields, elements=data.element_names,
             normalized_data=data.normalized, normalized_fitted=fn,
             polarimetric_weight=obj.weight, basis=data.basis,
             chi2_m00=float(r[:data.n] @ r[:data.n]),
@@ -493,14 +469,14 @@ def fit_mueller(model: Model | str, measurement: Measurement, *, loss: str = "re
     _refuse(model, measurement, channel, joint, shared)
     model = as_model(model)
     w_p = check_polarimetric_weight(polarimetric_weight)
-    ap = Aperture.parse(aperture, aperture_points)
-    opts = DataOptions(Comparison.of(measurement, relative_to), loss, weights, nonfinite,
-                       negative, ap, theta_r_max, source_exclusion, extrapolated)
-    search = SearchOptions(starts, screen, subsample, polish, max_nfev, seed)
-    k_free, k_fixed = data_scale(measurement, free_scale, scale)
-    params = FreeParameters.of(model, fix, bounds)
-    spec = params.spec(model, loss=loss, quantity=opts.comparison.quantity, free_scale=k_free,
-                       fixed_scale=k_fixed)
+    plan = FitPlan.of(model, measurement, loss=loss, weights=weights, fix=fix, bounds=bounds,
+                      starts=starts, seed=seed, nonfinite=nonfinite, negative=negative,
+                      relative_to=relative_to, free_scale=free_scale, scale=scale,
+                      screen=screen, subsample=subsample, polish=polish, max_nfev=max_nfev,
+                      aperture=aperture, aperture_points=aperture_points,
+                      theta_r_max=theta_r_max, source_exclusion=source_exclusion,
+                      extrapolated=extrapolated)
+    spec, search, opts = plan.spec, plan.search, plan.opts
     data = prepare_mueller(model, measurement, opts)
     check_enough_data(measurement, [data], spec.n_varys)  # type: ignore[list-item]
     with progress_bar(progress, search.starts, f"fit {model_label(model)} (Mueller)") as bar, \
@@ -510,25 +486,9 @@ def fit_mueller(model: Model | str, measurement: Measurement, *, loss: str = "re
         obj, outcome = _MuellerSearch(spec, search, w_p, tick).run(data)  # type: ignore[arg-type]
         result = MuellerChannelFit.from_mueller_search(obj, outcome,  # type: ignore[arg-type]
                                                        time.perf_counter() - t0)
-    options = {"starts": search.starts, "seed": seed, "subsample": subsample,
-               "polish": search.polish, "nonfinite": nonfinite, "negative": negative,
-               "free_scale": k_free, "scale": scale,
-               "aperture": None if ap is None else ap.half_angle,
-               "aperture_points": None if ap is None else ap.points,
-               "theta_r_max": opts.theta_r_max, "source_exclusion": opts.source_exclusion,
-               "extrapolated": extrapolated, "joint": None,
-               "fix": sorted(set(model.param_names) - set(params.names)),
-               "weights": None if weights is None else
-               (weights if isinstance(weights, str) else "array"),
-               "mueller": {"kind": measurement.mueller, "basis": measurement.mueller_basis,
-                           "elements": data.element_names, "polarimetric_weight": w_p,
-                           "residuals": "m00: the loss; m_ij/m00: absolute difference x "
-                                        "polarimetric_weight"}}
-    return MuellerFitResult(channels=[result], measurement=measurement,
-                            model_name=model_label(model), loss=loss,
-                            compared=opts.comparison.compared,
-                            relative_to=opts.comparison.relative_to, options=options,
-                            elapsed=time.perf_counter() - t_start,
-                            aperture=None if ap is None else ap.half_angle,
-                            aperture_points=19 if ap is None else ap.points,
-                            source=input_source(measurement))
+    mueller = {"kind": measurement.mueller, "basis": measurement.mueller_basis,
+               "elements": data.element_names, "polarimetric_weight": w_p,
+               "residuals": "m00: the loss; m_ij/m00: absolute difference x "
+                            "polarimetric_weight"}
+    return MuellerFitResult(channels=[result], **plan.result_fields(
+        measurement, time.perf_counter() - t_start, joint=None, mueller=mueller))

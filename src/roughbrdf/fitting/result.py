@@ -11,7 +11,6 @@ content
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 import os
@@ -147,12 +146,21 @@ class ChannelFit:
     def from_search(cls, obj: Objective, outcome: SearchOutcome, elapsed: float) -> ChannelFit:
         """The channel's result at the search's optimum: statistics on all samples of ``obj``
         (:mod:`~roughbrdf.fitting.statistics`)."""
-        spec, data, theta = obj.spec, obj.data, outcome.theta
+        f = obj.values(outcome.theta)
+        return cls(**cls.fields_at_optimum(obj, outcome, elapsed, f, obj.data.values, f))
+
+    @staticmethod
+    def fields_at_optimum(obj: Objective, outcome: SearchOutcome, elapsed: float,
+                          f: np.ndarray, data: np.ndarray, fitted: np.ndarray
+                          ) -> dict[str, Any]:
+        """The fields of a :class:`ChannelFit` at the search's optimum, from the model values
+        ``f`` of ``obj`` there; ``data`` and ``fitted`` are what the figures of merit (sigma,
+        rms-log) compare (the measured and model values; for Mueller data their m00)."""
+        spec, theta = obj.spec, outcome.theta
         fitted_model = spec.model_at(theta)
-        f = obj.values(theta)
         k = obj.scale(f)
         r = obj.residual_of(f, k)
-        gof = GoodnessOfFit.of(r, data.values, f, scale=k, n_varys=spec.n_varys,
+        gof = GoodnessOfFit.of(r, data, fitted, scale=k, n_varys=spec.n_varys,
                                floor=obj.floor)
         bound = at_bound(theta, spec.lower, spec.upper, spec.free)
         cov = Covariance.at_optimum(obj, theta, f, k, chi2=gof.chi2, dof=gof.dof,
@@ -164,8 +172,8 @@ class ChannelFit:
         res = outcome.result
         message = (res.message.rstrip(".") if res is not None else "no local fit finished")
         message += cov.note + (f"; at a bound: {', '.join(bound)}" if bound else "")
-        return cls(
-            channel=data.label, model=fitted_model, params=fitted_model.params,
+        return dict(
+            channel=obj.data.label, model=fitted_model, params=fitted_model.params,
             free=list(spec.free), init=spec.start_values(),
             bounds={nm: (float(a), float(b))
                     for nm, a, b in zip(spec.free, spec.lower, spec.upper, strict=True)},
@@ -174,9 +182,9 @@ class ChannelFit:
             success=bool(res.success) if res is not None else False, message=message,
             sigma=gof.sigma, rms_log=gof.rms_log, chi2=gof.chi2, redchi=gof.redchi,
             aic=gof.aic, bic=gof.bic, n_points=gof.n_points, n_varys=gof.n_varys,
-            excluded=data.excluded, nfev=obj.nfev + outcome.explore_nfev, starts=outcome.tried,
-            free_scale=spec.free_scale, at_bound=bound, elapsed=elapsed, index=data.index,
-            data=data.values, fitted=f, residual=r)
+            excluded=obj.data.excluded, nfev=obj.nfev + outcome.explore_nfev,
+            starts=outcome.tried, free_scale=spec.free_scale, at_bound=bound, elapsed=elapsed,
+            index=obj.data.index, data=data, fitted=fitted, residual=r)
 
     def to_dict(self) -> dict[str, Any]:
         """This channel's entry of ``fit.json`` (before NaN -> null)."""
@@ -498,14 +506,9 @@ def input_source(meas: Measurement) -> dict[str, str | None]:
         return out
     out["file_abspath"] = out["file_abspath"] or str(path.resolve())
     if not out["file_sha256"]:
-        h = hashlib.sha256()
-        try:
-            with open(path, "rb") as fh:
-                for block in iter(lambda: fh.read(1 << 20), b""):
-                    h.update(block)
-        except OSError:
-            return out
-        out["file_sha256"] = h.hexdigest()
+        from ..output import file_sha256
+
+        out["file_sha256"] = file_sha256(path)
     return out
 
 

@@ -20,11 +20,11 @@ from ..errors import ArgumentError
 from ..measurement import Measurement
 from ..models import Model, Parameter
 from ..quantity import Quantity
-from .data import ChannelData, where
+from .data import ChannelData, Comparison, DataOptions, where
 from .objective import ObjectiveSpec
 
-__all__ = ["BoundsFix", "FreeParameters", "as_model", "channel_indices", "check_enough_data",
-           "data_scale", "model_label"]
+__all__ = ["BoundsFix", "FitPlan", "FreeParameters", "as_model", "channel_indices",
+           "check_enough_data", "data_scale", "model_label"]
 
 
 def as_model(model: Model | str) -> Model:
@@ -202,3 +202,65 @@ def check_enough_data(meas: Measurement, data: Sequence[ChannelData], n_varys: i
         if d.n <= n_varys:
             raise ValueError(f"{where(meas, d.label)}: {d.n} samples for {n_varys} fitted "
                              f"parameters; need more data than parameters")
+
+
+@dataclass(frozen=True)
+class FitPlan:
+    """What one call of :func:`roughbrdf.fit` (or its Mueller form) does, checked before any
+    work: the data options, the search, the free parameters and their
+    :class:`~roughbrdf.fitting.objective.ObjectiveSpec`, and the ``options`` of ``fit.json``."""
+
+    model: Model
+    opts: DataOptions
+    search: Any  # SearchOptions (imported lazily: setup does not import the search)
+    params: FreeParameters
+    spec: ObjectiveSpec
+    recorded: dict[str, Any]
+
+    @classmethod
+    def of(cls, model: Model, measurement: Measurement, *, loss: str, weights: Any,
+           fix: Iterable[str], bounds: Mapping[str, Sequence[float]] | None, starts: int,
+           seed: int | None, nonfinite: str, negative: str, relative_to: str | None,
+           free_scale: bool | None, scale: float | None, screen: int,
+           subsample: int | None, polish: int, max_nfev: int | None, aperture: Any,
+           aperture_points: int, theta_r_max: float | None,
+           source_exclusion: float | None, extrapolated: str) -> FitPlan:
+        """Check every option (ArgumentError naming it) and build the plan."""
+        from ..instrument import Aperture
+        from .search import SearchOptions
+
+        ap = Aperture.parse(aperture, aperture_points)
+        opts = DataOptions(Comparison.of(measurement, relative_to), loss, weights, nonfinite,
+                           negative, ap, theta_r_max, source_exclusion, extrapolated)
+        search = SearchOptions(starts, screen, subsample, polish, max_nfev, seed)
+        k_free, k_fixed = data_scale(measurement, free_scale, scale)
+        params = FreeParameters.of(model, fix, bounds)
+        spec = params.spec(model, loss=loss, quantity=opts.comparison.quantity,
+                           free_scale=k_free, fixed_scale=k_fixed)
+        recorded = {
+            "starts": search.starts, "seed": seed, "subsample": subsample,
+            "polish": search.polish, "nonfinite": nonfinite, "negative": negative,
+            "free_scale": k_free, "scale": scale,
+            "aperture": None if ap is None else ap.half_angle,
+            "aperture_points": None if ap is None else ap.points,
+            "theta_r_max": opts.theta_r_max, "source_exclusion": opts.source_exclusion,
+            "extrapolated": extrapolated,
+            "fix": sorted(set(model.param_names) - set(params.names)),
+            "weights": None if weights is None else
+            (weights if isinstance(weights, str) else "array")}
+        return cls(model, opts, search, params, spec, recorded)
+
+    def result_fields(self, measurement: Measurement, elapsed: float,
+                      **options: Any) -> dict[str, Any]:
+        """The fields of a :class:`~roughbrdf.fitting.result.FitResult` of this plan besides
+        its channels; ``options`` adds to (or sets) the recorded ``options``."""
+        from .result import input_source
+
+        ap = self.opts.aperture
+        return {"measurement": measurement, "model_name": model_label(self.model),
+                "loss": self.spec.loss, "compared": self.opts.comparison.compared,
+                "relative_to": self.opts.comparison.relative_to,
+                "options": {**self.recorded, **options}, "elapsed": elapsed,
+                "aperture": None if ap is None else ap.half_angle,
+                "aperture_points": 19 if ap is None else ap.points,
+                "source": input_source(measurement)}

@@ -10,16 +10,27 @@ replaced without ``--force``). The fit options are those of ``roughbrdf fit``.
 from __future__ import annotations
 
 import json
-from typing import Annotated, Any
+from typing import Any
 
 import typer
 
 from .common import handled
 from .fit import OPTIONS as FIT_OPTIONS
 from .fit import (
+    AnglesInOption,
+    ApertureOption,
+    ChannelOption,
     CvOption,
+    FormatOption,
     JointOption,
     KeepExtrapolatedOption,
+    LossOption,
+    NegativeOption,
+    QuantityOption,
+    SeedOption,
+    SourceExclusionOption,
+    StartsOption,
+    ThetaRMaxOption,
     check_aperture,
     fit_domain,
     read_input,
@@ -77,27 +88,19 @@ def register(app: typer.Typer) -> None:
         out: str = typer.Option(None, "--out", "-o",
                                 help="also write compare.md, compare.json, compare.png here"),
         cv: CvOption = True,
-        channel: Annotated[list[str] | None, typer.Option(
-            "--channel", "-c", help="channel label or index (repeatable; default: all)")] = None,
-        loss: str = typer.Option("relative", help="relative ((x-f)/f, TR75), log or absolute"),
-        starts: int = typer.Option(8, help="multistart points per channel"),
+        channel: ChannelOption = None,
+        loss: LossOption = "relative",
+        starts: StartsOption = 8,
         joint: JointOption = False,
-        quantity: str = typer.Option(None, help="input: what the file's values are, if the "
-                                                "file does not say"),
-        angles_in: str = typer.Option(None, "--angles-in", metavar="deg|rad",
-                                      help="input: angle unit of an ASTM or CSV file"),
-        file_format: str = typer.Option(None, "--format", help="override the format chosen "
-                                                               "from the extension"),
-        aperture: float = typer.Option(None, "--aperture", metavar="DEG",
-                                       help="instrument aperture half-angle in degrees"),
-        theta_r_max: float = typer.Option(None, "--theta-r-max", metavar="DEG",
-                                          help="fit domain: leave out theta_r above DEG"),
-        source_exclusion: float = typer.Option(None, "--source-exclusion", metavar="DEG",
-                                               help="fit domain: leave out samples within DEG "
-                                                    "of the direction toward the source"),
+        quantity: QuantityOption = None,
+        angles_in: AnglesInOption = None,
+        file_format: FormatOption = None,
+        aperture: ApertureOption = None,
+        theta_r_max: ThetaRMaxOption = None,
+        source_exclusion: SourceExclusionOption = None,
         keep_extrapolated: KeepExtrapolatedOption = False,
-        negative: str = typer.Option("keep", help="negative values: keep, drop or clip"),
-        seed: int = typer.Option(0, help="seed of the Sobol starts and the subsample"),
+        negative: NegativeOption = "keep",
+        seed: SeedOption = 0,
         plots: bool = typer.Option(True, "--plots/--no-plots", help="write compare.png"),
         force: bool = typer.Option(False, "--force", help="replace an earlier run's results"),
     ) -> None:

@@ -74,6 +74,50 @@ KeepExtrapolatedOption = Annotated[bool, typer.Option(
                                 "measured range (default: left out and counted)")]
 
 
+ParamOption = Annotated[list[str] | None, typer.Option(
+    "-p", "--param", help="starting value or option, name=value (repeatable)")]
+FixOption = Annotated[list[str] | None, typer.Option(
+    "--fix", help="keep this parameter at its value (repeatable)")]
+BoundsOption = Annotated[list[str] | None, typer.Option(
+    "--bounds", metavar="NAME=LOW:HIGH",
+    help="search range of a parameter, e.g. e=0.1:2 (repeatable; names as for --fix; a "
+         "default starting value outside it starts in the middle)")]
+ChannelOption = Annotated[list[str] | None, typer.Option(
+    "--channel", "-c", help="channel label or index (repeatable; default: all)")]
+LossOption = Annotated[str, typer.Option(help="relative ((x-f)/f, TR75), log or absolute")]
+StartsOption = Annotated[int, typer.Option(help="multistart points per channel")]
+QuantityOption = Annotated[str | None, typer.Option(
+    help="input: what the file's values are, if the file does not say: brdf, brdf_cos "
+         "(= bridf), bridf or relative")]
+AnglesInOption = Annotated[str | None, typer.Option(
+    "--angles-in", metavar="deg|rad",
+    help="input: angle unit of an ASTM or CSV file, overriding the file")]
+RelativeToOption = Annotated[str | None, typer.Option(
+    "--relative-to",
+    help="for relative data: brdf or bridf (default: the file's relative_to, else brdf)")]
+FormatOption = Annotated[str | None, typer.Option(
+    "--format", help="override the format chosen from the extension")]
+NonfiniteOption = Annotated[str, typer.Option(help="non-finite values: raise or drop")]
+NegativeOption = Annotated[str, typer.Option(help="negative values: keep, drop or clip")]
+SeedOption = Annotated[int, typer.Option(help="seed of the Sobol starts and the subsample")]
+FreeScaleOption = Annotated[bool | None, typer.Option(
+    "--free-scale/--no-free-scale",
+    help="fit a free scale K of the data in closed form (x -> K x; default: only for "
+         "relative data)")]
+ApertureOption = Annotated[float | None, typer.Option(
+    "--aperture", metavar="DEG",
+    help="instrument aperture: half-angle in degrees of a uniform cone about the reflection "
+         "direction; the model is averaged over it (default: none)")]
+ThetaRMaxOption = Annotated[float | None, typer.Option(
+    "--theta-r-max", metavar="DEG",
+    help="fit domain: leave out samples with theta_r above DEG (counted; default: none)")]
+SourceExclusionOption = Annotated[float | None, typer.Option(
+    "--source-exclusion", metavar="DEG",
+    help="fit domain: leave out samples within DEG of the direction toward the source "
+         "(retro-blocked; counted; default: none)")]
+PlotsOption = Annotated[bool, typer.Option("--plots/--no-plots", help="write PNG plots")]
+
+
 def build_model(spec: str, params: dict[str, Any] | None = None) -> Model:
     """A model from ``name`` or ``name1+name2`` and ``-p`` settings (:func:`roughbrdf.model`)."""
     from .. import models as _models
@@ -289,47 +333,24 @@ def register(app: typer.Typer) -> None:
         keep_extrapolated: KeepExtrapolatedOption = False,
         out: str = typer.Option(..., "--out", "-o", help="output folder (refused if it holds "
                                                           "results, unless --force)"),
-        param: Annotated[list[str] | None, typer.Option(
-            "-p", "--param", help="starting value or option, name=value (repeatable)")] = None,
-        fix: Annotated[list[str] | None, typer.Option(
-            "--fix", help="keep this parameter at its value (repeatable)")] = None,
-        bounds: Annotated[list[str] | None, typer.Option(
-            "--bounds", metavar="NAME=LOW:HIGH",
-            help="search range of a parameter, e.g. e=0.1:2 (repeatable; names as for "
-                 "--fix; a default starting value outside it starts in the middle)")] = None,
-        channel: Annotated[list[str] | None, typer.Option(
-            "--channel", "-c", help="channel label or index (repeatable; default: all)")] = None,
-        loss: str = typer.Option("relative", help="relative ((x-f)/f, TR75), log or absolute"),
-        starts: int = typer.Option(8, help="multistart points per channel"),
-        quantity: str = typer.Option(None, help="input: what the file's values are, if the "
-                                                "file does not say: brdf, brdf_cos (= bridf), "
-                                                "bridf or relative"),
-        angles_in: str = typer.Option(None, "--angles-in", metavar="deg|rad",
-                                      help="input: angle unit of an ASTM or CSV file, "
-                                           "overriding the file"),
-        relative_to: str = typer.Option(None, "--relative-to",
-                                        help="for relative data: brdf or bridf (default: the "
-                                             "file's relative_to, else brdf)"),
-        file_format: str = typer.Option(None, "--format", help="override the format chosen "
-                                                               "from the extension"),
-        nonfinite: str = typer.Option("raise", help="non-finite values: raise or drop"),
-        negative: str = typer.Option("keep", help="negative values: keep, drop or clip"),
-        seed: int = typer.Option(0, help="seed of the Sobol starts and the subsample"),
-        free_scale: bool = typer.Option(None, "--free-scale/--no-free-scale",
-                                        help="fit a free scale K of the data in closed form "
-                                             "(x -> K x; default: only for relative data)"),
-        aperture: float = typer.Option(None, "--aperture", metavar="DEG",
-                                       help="instrument aperture: half-angle in degrees of a "
-                                            "uniform cone about the reflection direction; the "
-                                            "model is averaged over it (default: none)"),
-        theta_r_max: float = typer.Option(None, "--theta-r-max", metavar="DEG",
-                                          help="fit domain: leave out samples with theta_r "
-                                               "above DEG (counted; default: none)"),
-        source_exclusion: float = typer.Option(None, "--source-exclusion", metavar="DEG",
-                                               help="fit domain: leave out samples within DEG "
-                                                    "of the direction toward the source "
-                                                    "(retro-blocked; counted; default: none)"),
-        plots: bool = typer.Option(True, "--plots/--no-plots", help="write PNG plots"),
+        param: ParamOption = None,
+        fix: FixOption = None,
+        bounds: BoundsOption = None,
+        channel: ChannelOption = None,
+        loss: LossOption = "relative",
+        starts: StartsOption = 8,
+        quantity: QuantityOption = None,
+        angles_in: AnglesInOption = None,
+        relative_to: RelativeToOption = None,
+        file_format: FormatOption = None,
+        nonfinite: NonfiniteOption = "raise",
+        negative: NegativeOption = "keep",
+        seed: SeedOption = 0,
+        free_scale: FreeScaleOption = None,
+        aperture: ApertureOption = None,
+        theta_r_max: ThetaRMaxOption = None,
+        source_exclusion: SourceExclusionOption = None,
+        plots: PlotsOption = True,
         force: bool = typer.Option(False, "--force",
                                    help="replace the results of an earlier run in --out (files "
                                         "roughbrdf did not write are never replaced)"),

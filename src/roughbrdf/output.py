@@ -39,8 +39,9 @@ from typing import IO, Any
 
 from .interrupts import held_interrupts, raise_if_interrupted
 
-__all__ = ["atomic_write", "staged", "same_file", "ensure_folder", "file_sha256", "refuse_existing",
-           "ResultFolder", "OverwriteRefused", "MANIFEST", "LOCK", "TMP_PREFIX"]
+__all__ = ["atomic_write", "staged", "same_file", "ensure_folder", "file_sha256",
+           "lock_is_stale", "refuse_existing", "ResultFolder", "OverwriteRefused", "MANIFEST",
+           "LOCK", "TMP_PREFIX"]
 
 #: prefix of the temporary files (a leftover one, after a power cut, is recognizable)
 TMP_PREFIX = ".roughbrdf-tmp-"
@@ -380,7 +381,7 @@ class ResultFolder:
         names = list(names)
         self._check_location()
         if not self._locked and (self.path / LOCK).exists() \
-                and not _lock_is_stale(self.path / LOCK):
+                and not lock_is_stale(self.path / LOCK):
             raise OverwriteRefused(self.path, locked=True)
         old = set(self.previous())
         present = {n for n in names if (self.path / n).exists()}
@@ -466,7 +467,7 @@ class ResultFolder:
                         fh.write(f"{os.getpid()}\n")
             if self._locked:
                 return
-            if not _lock_is_stale(lock):
+            if not lock_is_stale(lock):
                 raise OverwriteRefused(self.path, locked=True)
             with contextlib.suppress(FileNotFoundError):
                 lock.unlink()
@@ -489,7 +490,7 @@ def _write_manifest(folder: Path, names: list[str]) -> None:
     atomic_write(folder / MANIFEST, json.dumps(names, indent=1) + "\n", overwrite=True)
 
 
-def _lock_is_stale(lock: Path) -> bool:
+def lock_is_stale(lock: Path) -> bool:
     """Whether ``lock`` names a process that no longer exists (on this machine)."""
     try:
         pid = int(lock.read_text().split()[0])

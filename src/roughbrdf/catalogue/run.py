@@ -208,37 +208,21 @@ def _workers_of(client: Any, futures: list[Any]) -> set[str]:
 
 def tidy(folder: str | os.PathLike) -> None:
     """Remove the temporary files and the lock that a killed task left in its fit folder
-    (only those of processes that no longer exist on this machine)."""
-    from ..output import LOCK, TMP_PREFIX
+    (only when no live process on this machine holds the folder's lock:
+    :func:`roughbrdf.output.lock_is_stale`)."""
+    from ..output import LOCK, TMP_PREFIX, lock_is_stale
 
     path = Path(folder)
     lock = path / LOCK
-    try:
-        pid = int(lock.read_text().split()[0])
-    except (OSError, ValueError, IndexError):
-        pid = None
-    if pid is not None and _alive(pid):
+    if not lock_is_stale(lock):
         return
     for p in path.glob(f"{TMP_PREFIX}*") if path.is_dir() else []:
         with contextlib.suppress(OSError):
             p.unlink()
-    if pid is not None:
-        with contextlib.suppress(OSError):
-            lock.unlink()
+    with contextlib.suppress(OSError):
+        lock.unlink()
     with contextlib.suppress(OSError):
         path.rmdir()  # only if empty: a folder the task had just created
-
-
-def _alive(pid: int) -> bool:
-    if pid == os.getpid():
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OverflowError):
-        return True
-    return True
 
 
 def _bar(progress: bool | None, total: int, skipped: int) -> Any:

@@ -27,15 +27,16 @@ Needs ``../shared/data`` (or ``ROUGHBRDF_SHARED_DATA``); prints a note and retur
    chosen. With ``--docs`` the fit plots are saved as ``docs/img/rb08_<file>.png``: the
    panels of ``FitResult.plot`` (drawn through the fit's aperture) and a zoom on the retro peak
    with the model at each direction and through the aperture.
-5. **RB08 on one Mini-Diff channel** (``--rb08-paints`` runs only this): the 14-parameter fit
-   of channel 465 nm of each paint (relative loss, ``rb.fit`` defaults) with the literal and the
-   numeric normalization: time, cost (chi-square) and model evaluations, against the fit with
-   the bulk and retro terms switched off (``bulk = retro = 0`` fixed, and ``rho_r, w_r, n_r``,
-   which then do nothing); and where one evaluation's time goes (the tabulated kernel that
-   runs real ``n``, the general kernel it replaced, the numeric N of one lobe at the
-   channel's four incidences). Until 2026-12 the numeric-N fit of C2_Black took ~40-77 s
-   (the 2-D lobe quadrature, ~3 ms per incidence and parameter change) and the literal fit of
-   C8_Silver ~40-60 s (the general kernel, 1.6 ms per evaluation).
+5. **RB08 on one Mini-Diff channel** (part of the default run; ``--rb08-paints`` runs only
+   this): the 14-parameter fit of channel 465 nm of each paint (relative loss, ``rb.fit``
+   defaults) with the literal and the numeric normalization: time, cost (chi-square) and
+   model evaluations, against the fit with the bulk and retro terms switched off (``bulk =
+   retro = 0`` fixed, and ``rho_r, w_r, n_r``, which then do nothing); and where one
+   evaluation's time goes (the tabulated kernel that runs real ``n``, the general kernel it
+   replaced, the numeric N of one lobe at the channel's four incidences). Until 2026-12 the
+   numeric-N fit of C2_Black took ~40-77 s (the 2-D lobe quadrature, ~3 ms per incidence and
+   parameter change) and the literal fit of C8_Silver ~40-60 s (the general kernel, 1.6 ms per
+   evaluation), then 11.8 s (the polish creeping towards a bound; docs/fitting.md, "Polish").
 """
 
 from __future__ import annotations

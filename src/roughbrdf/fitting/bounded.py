@@ -7,10 +7,11 @@ of ``J``, Marquardt's scaling; the largest seen so far, as in MINPACK), **subjec
 bounds** ``lower <= x + p <= upper``: a small bounded linear least-squares problem on the
 ``k x k`` triangle of ``J`` (:func:`bounded_step`, SciPy's BVLS). A parameter whose optimum
 lies on its bound therefore reaches it in one step, where the interior-point trust region
-(``least_squares``' ``trf``) approaches it geometrically: on a 14-parameter RB08 fit of a
-Mini-Diff paint, ``trf`` spent 9,000-19,000 evaluations creeping towards ``n_eff = 5`` and
-stopped short of it by its ``ftol`` test (docs/benchmarks.md). ``lambda`` follows Nielsen's
-rule (H. B. Nielsen, *Damping parameter in Marquardt's method*, IMM-REP-1999-05).
+(``least_squares``' ``trf``), whose iterates stay strictly inside, creeps towards it: on a
+14-parameter RB08 fit of a Mini-Diff paint, ``trf`` spent 9,000-19,000 evaluations moving
+``n_eff`` from 4.7 to 4.93 of its bound 5 and then stopped by its ``ftol`` test. ``lambda``
+follows Nielsen's rule (H. B. Nielsen, *Damping parameter in Marquardt's method*,
+IMM-REP-1999-05).
 
 Converged means the model with the bounds predicts no worthwhile decrease: the undamped
 bounded step from the point lowers ``m`` by at most ``tol`` times the cost. This holds at a
@@ -110,7 +111,7 @@ def bounded_step(jac: np.ndarray, f: np.ndarray, x: np.ndarray, lower: np.ndarra
 
 
 def bounded_lm(obj: Objective, x0: np.ndarray, tol: float, max_nfev: int | None = None
-           ) -> BoundedResult:
+               ) -> BoundedResult:
     """Minimize ``obj`` within its bounds from ``x0`` (module notes); ``max_nfev`` caps the
     residual evaluations (default ``100 k``, ``least_squares``' default for ``k`` unknowns),
     ``tol`` is the convergence test's fraction of the cost.
@@ -142,12 +143,12 @@ def bounded_lm(obj: Objective, x0: np.ndarray, tol: float, max_nfev: int | None 
         # a column of zeros (a parameter the residuals do not depend on) gets unit scaling
         scale2 = np.where(d2 > 0, d2, 1.0)
         if bounded_step(jac, f, x, lo, hi)[1] <= tol * cost:
-            return BoundedResult(x, cost, 1, "the bounded Gauss-Newton step predicts a decrease "
-                            f"below {tol:g} of the cost", nfev, njev)
+            return BoundedResult(x, cost, 1, "the bounded Gauss-Newton step predicts a "
+                                 f"decrease below {tol:g} of the cost", nfev, njev)
         while True:
             if nfev >= budget:
-                return BoundedResult(x, cost, 0, "the evaluation budget (max_nfev) is used up",
-                                nfev, njev)
+                return BoundedResult(x, cost, 0, "the evaluation budget (max_nfev) is used "
+                                     "up", nfev, njev)
             if lam > LAMBDA_MAX:
                 return BoundedResult(x, cost, 3, "no step lowers the cost", nfev, njev)
             p, pred = bounded_step(jac, f, x, lo, hi, lam * scale2)

@@ -5,9 +5,10 @@ minimum within the bounds: the end of the polish (:func:`roughbrdf.fitting.searc
 ``m(p) = 1/2 |f + J p|^2``, plus the damping ``1/2 lambda |D p|^2`` (``D`` the column norms
 of ``J``, Marquardt's scaling; the largest seen so far, as in MINPACK), **subject to the
 bounds** ``lower <= x + p <= upper``: a small bounded linear least-squares problem on the
-``k x k`` triangle of ``J`` (:func:`bounded_step`, SciPy's BVLS). A parameter whose optimum
-lies on its bound therefore reaches it in one step, where the interior-point trust region
-(``least_squares``' ``trf``), whose iterates stay strictly inside, creeps towards it: on a
+``k x k`` triangle of ``J``, factored once per Jacobian (:class:`GaussNewtonModel`,
+:func:`bounded_step`, SciPy's BVLS). A parameter whose optimum lies on its bound therefore
+reaches it in one step, where the interior-point trust region (``least_squares``' ``trf``),
+whose iterates stay strictly inside, creeps towards it: on a
 14-parameter RB08 fit of a Mini-Diff paint, ``trf`` spent 9,000-19,000 evaluations moving
 ``n_eff`` from 4.7 to 4.93 of its bound 5 and then stopped by its ``ftol`` test. ``lambda``
 follows Nielsen's rule (H. B. Nielsen, *Damping parameter in Marquardt's method*,
@@ -28,7 +29,7 @@ import numpy as np
 from ..interrupts import held_interrupts
 from .objective import Objective
 
-__all__ = ["BoundedResult", "bounded_lm", "bounded_step"]
+__all__ = ["BoundedResult", "GaussNewtonModel", "bounded_lm", "bounded_step"]
 
 #: Nielsen's initial damping, relative to Marquardt's scaling ``D^2``
 LAMBDA0 = 1e-3
@@ -71,6 +72,44 @@ class BoundedResult:
         return self.status in (1, 2)
 
 
+@dataclass(frozen=True)
+class GaussNewtonModel:
+    """The Gauss–Newton model ``1/2 |f + J p|^2`` of the cost at one point, kept as the
+    triangle ``R`` of ``J = Q R`` and ``c = Q^T f`` (``|f + J p|^2 = |c + R p|^2`` plus a
+    constant): factored once per Jacobian, then solved for any damping."""
+
+    r: np.ndarray
+    c: np.ndarray
+
+    @classmethod
+    def of(cls, jac: np.ndarray, f: np.ndarray) -> GaussNewtonModel:
+        """The model of residuals ``f`` with Jacobian ``jac``."""
+        q, r = np.linalg.qr(jac, mode="reduced")
+        return cls(r, q.T @ f)
+
+    def step(self, x: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+             damping: np.ndarray | None = None) -> tuple[np.ndarray, float]:
+        """:func:`bounded_step` on this model."""
+        with held_interrupts():  # the first import loads compiled modules (search.sobol_points)
+            from scipy.optimize import lsq_linear
+
+        r, c = self.r, self.c
+        a, b = r, -c
+        if damping is not None:
+            a = np.vstack([r, np.diag(np.sqrt(damping))])
+            b = np.concatenate([-c, np.zeros(len(x))])
+        lo, hi = lower - x, upper - x
+        # lsq_linear needs lo < hi: a variable whose bounds coincide (after clipping x into the
+        # box, lo <= 0 <= hi always) cannot move
+        fixed = hi - lo <= 0
+        lo, hi = np.where(fixed, -1.0, lo), np.where(fixed, 1.0, hi)
+        p = lsq_linear(a, b, bounds=(lo, hi), method="bvls").x
+        p = np.where(fixed, 0.0, np.clip(p, lo, hi))
+        # the model decrease, on the triangle: 1/2 |c|^2 - 1/2 |c + R p|^2
+        pred = 0.5 * float(c @ c) - 0.5 * float(np.sum((c + r @ p) ** 2))
+        return p, pred
+
+
 def bounded_step(jac: np.ndarray, f: np.ndarray, x: np.ndarray, lower: np.ndarray,
                  upper: np.ndarray, damping: np.ndarray | None = None
                  ) -> tuple[np.ndarray, float]:
@@ -78,8 +117,8 @@ def bounded_step(jac: np.ndarray, f: np.ndarray, x: np.ndarray, lower: np.ndarra
     ``lower <= x + p <= upper``, and the decrease of the Gauss–Newton model it predicts,
     ``1/2 |f|^2 - 1/2 |f + J p|^2``.
 
-    Solved on the triangle ``R`` of ``J = Q R`` (``|f + J p|^2 = |Q^T f + R p|^2`` plus a
-    constant) with ``scipy.optimize.lsq_linear(method="bvls")``.
+    Solved on the triangle ``R`` of ``J = Q R`` (:class:`GaussNewtonModel`) with
+    ``scipy.optimize.lsq_linear(method="bvls")``.
 
     Examples
     --------
@@ -89,25 +128,7 @@ def bounded_step(jac: np.ndarray, f: np.ndarray, x: np.ndarray, lower: np.ndarra
     >>> p.round(12).tolist(), round(pred, 12)    # x2 stops on its bound -0.5
     ([2.0, -0.5], 2.375)
     """
-    with held_interrupts():  # the first import loads compiled modules (search.sobol_points)
-        from scipy.optimize import lsq_linear
-
-    q, r = np.linalg.qr(jac, mode="reduced")
-    c = q.T @ f
-    a, b = r, -c
-    if damping is not None:
-        a = np.vstack([r, np.diag(np.sqrt(damping))])
-        b = np.concatenate([-c, np.zeros(len(x))])
-    lo, hi = lower - x, upper - x
-    # lsq_linear needs lo < hi: a variable whose bounds coincide (after clipping x into the
-    # box, lo <= 0 <= hi always) cannot move
-    fixed = hi - lo <= 0
-    lo, hi = np.where(fixed, -1.0, lo), np.where(fixed, 1.0, hi)
-    p = lsq_linear(a, b, bounds=(lo, hi), method="bvls").x
-    p = np.where(fixed, 0.0, np.clip(p, lo, hi))
-    # the model decrease, on the triangle: 1/2 |c|^2 - 1/2 |c + R p|^2
-    pred = 0.5 * float(c @ c) - 0.5 * float(np.sum((c + r @ p) ** 2))
-    return p, pred
+    return GaussNewtonModel.of(jac, f).step(x, lower, upper, damping)
 
 
 def bounded_lm(obj: Objective, x0: np.ndarray, tol: float, max_nfev: int | None = None
@@ -139,10 +160,11 @@ def bounded_lm(obj: Objective, x0: np.ndarray, tol: float, max_nfev: int | None 
             return BoundedResult(x, cost, 2, "the cost is zero", nfev, njev)
         jac = obj.jac(x)
         njev += 1
+        model = GaussNewtonModel.of(jac, f)  # factored once for every trial step below
         d2 = np.maximum(d2, np.sum(jac * jac, axis=0))
         # a column of zeros (a parameter the residuals do not depend on) gets unit scaling
         scale2 = np.where(d2 > 0, d2, 1.0)
-        if bounded_step(jac, f, x, lo, hi)[1] <= tol * cost:
+        if model.step(x, lo, hi)[1] <= tol * cost:
             return BoundedResult(x, cost, 1, "the bounded Gauss-Newton step predicts a "
                                  f"decrease below {tol:g} of the cost", nfev, njev)
         while True:
@@ -151,7 +173,7 @@ def bounded_lm(obj: Objective, x0: np.ndarray, tol: float, max_nfev: int | None 
                                      "up", nfev, njev)
             if lam > LAMBDA_MAX:
                 return BoundedResult(x, cost, 3, "no step lowers the cost", nfev, njev)
-            p, pred = bounded_step(jac, f, x, lo, hi, lam * scale2)
+            p, pred = model.step(x, lo, hi, lam * scale2)
             x_new = np.clip(x + p, lo, hi)  # round-off of x + p past a bound
             f_new = obj.fun(x_new)
             nfev += 1

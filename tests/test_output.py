@@ -5,6 +5,7 @@ result sets, one run at a time, and Ctrl-C that is deferred or re-raised, never 
 from __future__ import annotations
 
 import errno
+import hashlib
 import json
 import os
 import signal
@@ -133,8 +134,10 @@ def test_ensure_folder_names_the_file_in_the_way(tmp_path):
 def test_result_folder_writes_the_set_and_its_manifest(tmp_path):
     out = tmp_path / "new" / "res"
     assert _write_set(out, {"b.txt": "B", "a.txt": "A"}) == ["a.txt", "b.txt"]
-    assert _files(out) == {MANIFEST: b'[\n "a.txt",\n "b.txt"\n]\n', "a.txt": b"A",
-                           "b.txt": b"B"}
+    files = _files(out)
+    assert json.loads(files.pop(MANIFEST)) == {
+        "a.txt": hashlib.sha256(b"A").hexdigest(), "b.txt": hashlib.sha256(b"B").hexdigest()}
+    assert files == {"a.txt": b"A", "b.txt": b"B"}
 
 
 def test_second_run_is_refused_unless_overwrite_which_replaces_exactly_the_old_set(tmp_path):
@@ -187,7 +190,9 @@ def test_a_file_that_failed_is_not_committed(tmp_path):
         out.add("good.txt", "g")
         with pytest.raises(RuntimeError):
             out.add("bad.txt", bad)
-    assert _files(tmp_path) == {MANIFEST: b'[\n "good.txt"\n]\n', "good.txt": b"g"}
+    files = _files(tmp_path)
+    assert sorted(json.loads(files.pop(MANIFEST))) == ["good.txt"]
+    assert files == {"good.txt": b"g"}
 
 
 def test_manifest_lists_only_files_that_exist(tmp_path):
@@ -305,6 +310,8 @@ def test_outside_watch_nothing_changes():
         pass
 
 
-def test_json_manifest_is_a_list_of_names(tmp_path):
-    _write_set(tmp_path, {"x.json": json.dumps({"a": 1})})
-    assert json.loads((tmp_path / MANIFEST).read_text()) == ["x.json"]
+def test_json_manifest_maps_names_to_their_sha256(tmp_path):
+    text = json.dumps({"a": 1})
+    _write_set(tmp_path, {"x.json": text})
+    assert json.loads((tmp_path / MANIFEST).read_text()) == {
+        "x.json": hashlib.sha256(text.encode()).hexdigest()}

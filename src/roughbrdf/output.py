@@ -30,21 +30,20 @@ from __future__ import annotations
 
 import contextlib
 import errno
-import json
 import os
 import tempfile
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import IO, Any
 
+from . import journal
 from .interrupts import held_interrupts, raise_if_interrupted
+from .journal import JOURNAL, LOCK, MANIFEST, TMP_PREFIX, file_sha256, lock_is_stale, tmp_prefix
 
 __all__ = ["atomic_write", "staged", "same_file", "ensure_folder", "file_sha256",
-           "lock_is_stale", "refuse_existing", "ResultFolder", "OverwriteRefused", "MANIFEST",
-           "LOCK", "TMP_PREFIX"]
-
-#: prefix of the temporary files (a leftover one, after a power cut, is recognizable)
-TMP_PREFIX = ".roughbrdf-tmp-"
+           "lock_is_stale", "refuse_existing", "ResultFolder", "OverwriteRefused",
+           "ManifestRefused", "recover", "read_manifest", "MANIFEST", "LOCK", "JOURNAL",
+           "TMP_PREFIX"]
 
 Content = str | bytes | Callable[[IO[Any]], None]
 
@@ -60,6 +59,9 @@ class OverwriteRefused(FileExistsError):
         Files of an earlier run (the folder's :data:`MANIFEST`) that would be replaced.
     foreign : list of str
         Files of the same names that roughbrdf did not write: never replaced.
+    changed : list of str
+        Files roughbrdf wrote whose content changed since (their hash in the manifest
+        differs): the user's now, never replaced or removed.
     locked : bool
         Another run is writing into the folder (its :data:`LOCK`).
 
@@ -69,10 +71,11 @@ class OverwriteRefused(FileExistsError):
 
     def __init__(self, path: str | os.PathLike, *, results: Iterable[str] = (),
                  foreign: Iterable[str] = (), overwrite: bool = False, locked: bool = False,
-                 single: bool = False) -> None:
+                 single: bool = False, changed: Iterable[str] = ()) -> None:
         self.path = Path(path)
         self.results = sorted(results)
         self.foreign = sorted(foreign)
+        self.changed = sorted(changed)
         self.overwrite = overwrite
         self.locked = locked
         self.single = single
@@ -96,7 +99,36 @@ class OverwriteRefused(FileExistsError):
             even = f", not even with {ask}" if self.overwrite else ""
             parts.append(f"{self.path}: not overwriting {', '.join(self.foreign)} (not written by "
                          f"roughbrdf{even}); move {them} away or choose another folder")
+        if self.changed:
+            them = "it" if len(self.changed) == 1 else "them"
+            even = f", not even with {ask}" if self.overwrite else ""
+            parts.append(f"{self.path}: not replacing or removing {', '.join(self.changed)} "
+                         f"(changed since roughbrdf wrote {them}{even}); move {them} away or "
+                         f"choose another folder")
         return "; ".join(parts)
+
+
+class ManifestRefused(OverwriteRefused):
+    """A results folder's manifest or commit journal that roughbrdf will not act on.
+
+    Attributes
+    ----------
+    record : pathlib.Path
+        The manifest (:data:`MANIFEST`) or journal (:data:`JOURNAL`).
+    reason : str
+        What is wrong with it (a name outside the folder, a symbolic link, not JSON ...).
+    """
+
+    def __init__(self, record: str | os.PathLike, reason: str) -> None:
+        self.record = Path(record)
+        self.reason = reason
+        super().__init__(self.record.parent)
+
+    def render(self, options: Mapping[str, str] | None = None) -> str:
+        """The message (the same for Python and the command line)."""
+        return (f"{self.record}: {self.reason}; roughbrdf will not act on this folder's "
+                f"records (a folder copied from elsewhere?): check it, and delete {self.record} "
+                f"if the files it names are not results of yours")
 
 
 def same_file(a: str | os.PathLike, b: str | os.PathLike) -> bool:
@@ -149,7 +181,7 @@ def ensure_folder(path: str | os.PathLike) -> Path:
 def _temporary(folder: Path, target: Path, binary: bool) -> tuple[str, IO[Any]]:
     """A new temporary file in ``folder``, open (errors name ``folder`` or ``target``)."""
     try:
-        fd, tmp = tempfile.mkstemp(prefix=TMP_PREFIX, suffix=".part", dir=folder)
+        fd, tmp = tempfile.mkstemp(prefix=tmp_prefix(), suffix=".part", dir=folder)
     except FileNotFoundError as exc:
         raise _located(exc, folder) from None
     except OSError as exc:
@@ -206,24 +238,6 @@ def staged(path: str | os.PathLike, *, overwrite: bool = False, binary: bool = F
         if tmp is not None:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
-
-
-def file_sha256(path: str | os.PathLike) -> str | None:
-    """SHA-256 (hex) of a file's bytes, read in 1 MiB blocks; None if it cannot be read.
-
-    The one fingerprint of an input file: ``fit.json``'s ``file_sha256``, the catalogue's
-    ``--resume`` and ``roughbrdf plot --fit``'s "changed since the fit" all use it.
-    """
-    import hashlib
-
-    h = hashlib.sha256()
-    try:
-        with open(path, "rb") as fh:
-            for block in iter(lambda: fh.read(1 << 20), b""):
-                h.update(block)
-    except OSError:
-        return None
-    return h.hexdigest()
 
 
 def refuse_existing(path: str | os.PathLike, overwrite: bool) -> None:
@@ -297,10 +311,45 @@ def atomic_write(path: str | os.PathLike, content: Content, *, overwrite: bool =
 # --------------------------------------------------------------------------------------------
 # a folder of results, written as one set
 # --------------------------------------------------------------------------------------------
-#: the record of the files roughbrdf wrote into a results folder (JSON list of names)
-MANIFEST = ".roughbrdf-outputs"
-#: present while a run writes into the folder (holds its process id)
-LOCK = ".roughbrdf-lock"
+def read_manifest(folder: str | os.PathLike) -> dict[str, str | None]:
+    """The files roughbrdf wrote into ``folder``, ``{name: sha256}`` (None: hash unknown, a
+    manifest of an older version); empty if the folder has no manifest.
+
+    Raises :class:`ManifestRefused` naming the manifest if it is not one roughbrdf can trust
+    (a symbolic link, not JSON, a name that is a path or leads outside the folder ...).
+    """
+    try:
+        return journal.read_manifest(folder)[0]
+    except journal.BadRecord as exc:
+        raise ManifestRefused(exc.path, exc.reason) from None
+
+
+def recover(folder: str | os.PathLike) -> list[Path]:
+    """Repair what killed processes left in ``folder``; returns the paths acted upon.
+
+    A commit journal (:data:`JOURNAL`) is rolled forward when every new file of the set is
+    still there with its recorded SHA-256, else back (the old set and manifest come back):
+    the folder then holds one complete set. The temporary files (:data:`TMP_PREFIX`) of
+    processes that no longer exist, and a lock (:data:`LOCK`) whose process no longer exists,
+    are removed. A live process's files are never touched: while another live run holds the
+    lock, only temporary files whose process id names a dead process are removed.
+    :class:`ResultFolder` calls this on entering a folder. Raises :class:`ManifestRefused` for
+    a journal roughbrdf did not write.
+    """
+    path = Path(folder)
+    if not path.is_dir():  # nothing to repair where nothing was written
+        return []
+    lock = path / LOCK
+    had_lock = lock.exists()
+    rf = ResultFolder(path)
+    try:
+        rf.take_lock()
+    except OverwriteRefused:  # a live run writes there: its own files are not ours to touch
+        return journal.remove_dead_temps(path, old_names=False)
+    try:
+        return rf.recovered + ([lock] if had_lock else [])
+    finally:
+        rf.release_lock()
 
 
 class ResultFolder:
@@ -317,38 +366,46 @@ class ResultFolder:
 
     * **refuse** (:class:`OverwriteRefused`, naming the files) if the folder holds the results
       of an earlier run (files its :data:`MANIFEST` lists) or any file this set would write,
-      unless ``overwrite``; even then a file of the same name that roughbrdf did not write is
-      refused (move it away): files the user made are never replaced;
+      unless ``overwrite``; even then a file of the same name that roughbrdf did not write, or
+      a listed file whose content changed since roughbrdf wrote it (its SHA-256 differs from
+      the manifest's), is refused: files the user made or edited are never replaced or
+      removed. ``adopt`` names files an older version wrote outside any set (or that the
+      caller names explicitly): with ``overwrite`` they may be replaced though unlisted;
+    * a manifest that is a symbolic link, not JSON, or lists a name that is a path, leads
+      outside the folder or is a symbolic link out of it, is refused
+      (:class:`ManifestRefused`, naming it) and never acted upon;
     * with ``overwrite``, the new set replaces exactly the old one: files of the old set that
       the new one does not write are removed, every other file stays;
     * ``extend=True`` adds files to the folder's set instead (``roughbrdf plot --fit DIR``
       adds its figures to the fit's results): the old set stays, and only files of the same
       names are replaced (with ``overwrite``);
-    * **all or nothing**: each file is written to a temporary file in the folder first; only
-      when all are written are they renamed into place, with Ctrl-C held
-      (:func:`roughbrdf.interrupts.held_interrupts`), then the manifest, then the stale files
-      go. An error or interrupt before that removes the temporary files and leaves the old set
-      as it was; the manifest only ever lists files that exist;
+    * **all or nothing, even if the process is killed**: each file is written to a temporary
+      file in the folder and fsynced; only when all are written is the commit journal
+      (:data:`JOURNAL`: names, SHA-256, backup names) written and fsynced; then, with Ctrl-C
+      held, each old file is renamed aside, each new one into place, the folder fsynced, the
+      manifest written, the backups and the journal removed. An error or interrupt before the
+      journal leaves the old set as it was; a kill after it is repaired by the next
+      :class:`ResultFolder` on the folder (:func:`recover`): old set or new, never a mix;
     * **one run at a time**: :data:`LOCK` is created exclusively; a second run is refused with a
       message naming the lock (a lock left by a process that no longer exists is taken over).
     """
 
     def __init__(self, path: str | os.PathLike, *, overwrite: bool = False,
-                 extend: bool = False) -> None:
+                 extend: bool = False, adopt: Iterable[str] = ()) -> None:
         self.path = Path(path)
         self.overwrite = overwrite
         self.extend = extend
+        self.adopt = frozenset(adopt)
         self._staged: dict[str, str] = {}  # name -> temporary file
+        self._hashes: dict[str, str] = {}  # name -> SHA-256 of the staged bytes
         self._locked = False
+        #: what :func:`recover` repaired on entering the folder
+        self.recovered: list[Path] = []
 
     # -- context ---------------------------------------------------------------------------
     def __enter__(self) -> ResultFolder:
         ensure_folder(self.path)
-        try:
-            self._lock()
-        except BaseException:
-            self._unlock()
-            raise
+        self.take_lock()
         return self
 
     def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
@@ -358,41 +415,46 @@ class ResultFolder:
         finally:
             with held_interrupts():  # a second Ctrl-C must not leave temporary files behind
                 self._discard()
-                self._unlock()
+                self.release_lock()
 
     # -- content ---------------------------------------------------------------------------
     def previous(self) -> list[str]:
-        """Names the folder's manifest lists (the last committed set), empty if none."""
-        m = self.path / MANIFEST
-        try:
-            data = json.loads(m.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            return []
-        return [str(x) for x in data] if isinstance(data, list) else []
+        """Names the folder's manifest lists (the last committed set), empty if none.
+
+        Raises :class:`ManifestRefused` for a manifest roughbrdf will not trust."""
+        return sorted(read_manifest(self.path))
 
     def check(self, names: Iterable[str]) -> None:
         """Raise if writing ``names`` here would break a rule (call it before expensive work).
 
         :class:`OverwriteRefused` for files the rules do not let this set replace or a folder
-        another run is writing into; :class:`NotADirectoryError` if the folder or one of its
-        parents is a file; :class:`PermissionError` if the folder (or the nearest existing
-        parent, where it would be created) cannot be written.
+        another run is writing into (:class:`ManifestRefused` for a manifest it will not
+        trust); :class:`NotADirectoryError` if the folder or one of its parents is a file;
+        :class:`PermissionError` if the folder (or the nearest existing parent, where it
+        would be created) cannot be written.
         """
-        names = list(names)
+        names = set(names)
         self._check_location()
+        if not self._locked and self.path.is_dir() and (
+                os.path.lexists(self.path / JOURNAL) or any(self.path.glob(f"{TMP_PREFIX}*"))):
+            recover(self.path)  # a killed run's commit: judge the set it leaves
         if not self._locked and (self.path / LOCK).exists() \
                 and not lock_is_stale(self.path / LOCK):
             raise OverwriteRefused(self.path, locked=True)
-        old = set(self.previous())
-        present = {n for n in names if (self.path / n).exists()}
-        foreign = present - old
-        if self.extend:
-            results = present & old
-        else:
-            results = {n for n in old if (self.path / n).exists()}
-        if foreign or (results and not self.overwrite):
+        old = read_manifest(self.path)
+        here = {n for n in names | set(old) | self.adopt if os.path.lexists(self.path / n)}
+        listed = {n for n in old if n in here}
+        adopted = (self.adopt & here) - listed
+        changed = {n for n in listed
+                   if old[n] is not None and file_sha256(self.path / n) != old[n]}
+        touched = (names & here) if self.extend else (names & here) | listed
+        foreign = (names & here) - listed - adopted
+        results = ((touched & listed) | (adopted & names)) - changed if self.extend \
+            else (listed | (adopted & names)) - changed
+        changed &= touched
+        if foreign or changed or (results and not self.overwrite):
             raise OverwriteRefused(self.path, results=() if self.overwrite else results,
-                                   foreign=foreign, overwrite=self.overwrite)
+                                   foreign=foreign, overwrite=self.overwrite, changed=changed)
 
     def _check_location(self) -> None:
         block = _blocking_file(self.path)
@@ -418,11 +480,12 @@ class ResultFolder:
                         os.unlink(self._staged.pop(name))
                 tmp, fh = _temporary(self.path, self.path / name, is_binary)
                 self._staged[name] = tmp
-            with _on_disk(fh, self.path / name) as out:
+            with _on_disk(fh, self.path / name) as out:  # fsynced before any rename
                 if callable(content):
                     content(out)
                 else:
                     out.write(content)
+            self._hashes[name] = file_sha256(tmp) or ""
         except BaseException:  # a file that failed is not part of the set
             if name in self._staged:
                 with contextlib.suppress(OSError):
@@ -438,21 +501,36 @@ class ResultFolder:
         raise_if_interrupted()  # a Ctrl-C that a library swallowed still stops the commit
         names = sorted(self._staged)
         self.check(names)
-        old = [n for n in self.previous() if (self.path / n).exists()]
-        stale = [] if self.extend else [n for n in old if n not in self._staged]
-        listed = sorted(set(names) | set(old)) if self.extend else names
+        try:
+            old, old_text = journal.read_manifest(self.path)
+        except journal.BadRecord as exc:  # changed since check(): refused all the same
+            raise ManifestRefused(exc.path, exc.reason) from None
+        kept = {n: h for n, h in old.items() if os.path.lexists(self.path / n)}
+        stale = [] if self.extend else [n for n in kept if n not in self._staged]
+        new = {n: (os.path.basename(self._staged[n]), self._hashes[n]) for n in names}
+        listed: dict[str, str | None] = {**kept, **self._hashes} if self.extend \
+            else dict(self._hashes)
         with held_interrupts():
             for name in names:
                 _keep_mode(self.path / name, self._staged[name])
-                os.replace(self._staged[name], self.path / name)
-                del self._staged[name]
-            _write_manifest(self.path, listed)
-            for n in stale:
-                with contextlib.suppress(FileNotFoundError):
-                    (self.path / n).unlink()
+            journal.commit_set(self.path, new, stale, listed, old_text)
+            self._staged.clear()
         return [self.path / n for n in names]
 
     # -- lock and clean-up -----------------------------------------------------------------
+    def take_lock(self) -> None:
+        """Take the folder's :data:`LOCK` (a stale one is taken over), then repair what a
+        killed run left (:func:`recover`); :class:`OverwriteRefused` if a live run holds it."""
+        try:
+            self._lock()
+            try:
+                self.recovered = journal.recover_locked(self.path)
+            except journal.BadRecord as exc:
+                raise ManifestRefused(exc.path, exc.reason) from None
+        except BaseException:
+            self.release_lock()
+            raise
+
     def _lock(self) -> None:
         lock = self.path / LOCK
         for _ in range(2):
@@ -473,7 +551,8 @@ class ResultFolder:
                 lock.unlink()
         raise OverwriteRefused(self.path, locked=True)
 
-    def _unlock(self) -> None:
+    def release_lock(self) -> None:
+        """Remove the folder's lock if this object holds it."""
         if self._locked:
             with contextlib.suppress(FileNotFoundError):
                 (self.path / LOCK).unlink()
@@ -484,28 +563,3 @@ class ResultFolder:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
         self._staged.clear()
-
-
-def _write_manifest(folder: Path, names: list[str]) -> None:
-    atomic_write(folder / MANIFEST, json.dumps(names, indent=1) + "\n", overwrite=True)
-
-
-def lock_is_stale(lock: Path) -> bool:
-    """Whether ``lock`` names a process that no longer exists (on this machine)."""
-    try:
-        pid = int(lock.read_text().split()[0])
-    except FileNotFoundError:
-        return True  # gone meanwhile
-    except (OSError, ValueError, IndexError):
-        return False  # being written right now, or not ours: treat as held
-    if pid == os.getpid() or os.name == "nt":
-        # this process writes there (another ResultFolder of ours); on Windows os.kill(pid, 0)
-        # would end the process instead of asking whether it exists: the lock counts as held
-        return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return True
-    except (PermissionError, OverflowError):
-        return False
-    return False

@@ -22,6 +22,12 @@ silences those messages for ``KeyboardInterrupt`` only, and every :func:`held_in
 block, :meth:`~roughbrdf.output.ResultFolder.commit` and :func:`raise_if_interrupted` raises
 ``KeyboardInterrupt`` again if one was swallowed. Outside :func:`watch` nothing changes.
 
+Once a program's work is done (the command line: its status is known and every file committed),
+:func:`record_interrupts` makes the rest of the :func:`watch` block record SIGINT instead of
+raising it, so that a late Ctrl-C cannot turn a finished run into a traceback.
+:func:`checkpoint` marks the statements of that tail: a no-op unless a test installed a hook
+(:func:`set_checkpoint_hook`) that sends the signal there.
+
 Examples
 --------
 >>> with held_interrupts():
@@ -37,16 +43,19 @@ import contextlib
 import signal
 import sys
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
-__all__ = ["held_interrupts", "watch", "interrupted", "raise_if_interrupted"]
+__all__ = ["held_interrupts", "watch", "interrupted", "raise_if_interrupted",
+           "record_interrupts", "late_interrupts", "checkpoint", "set_checkpoint_hook"]
 
 _depth = 0
 _pending: list[Any] = []
 _watching = 0
 _seen = False
 _hooks: list[Any] = []  # the unraisable hook that watch() replaced
+_late: list[int] = []  # SIGINTs recorded after record_interrupts()
+_checkpoint_hook: list[Callable[[str], None]] = []  # test-only (set_checkpoint_hook)
 
 
 def _record(signum: int, frame: Any) -> None:
@@ -134,12 +143,16 @@ def watch() -> Iterator[None]:
     _hooks.append(sys.unraisablehook)
     sys.unraisablehook = _unraisable
     _watching, _seen = 1, False
+    _late.clear()
     try:
         yield
     finally:
         _watching, _seen = 0, False
+        _late.clear()
         sys.unraisablehook = _hooks.pop()
-        if signal.getsignal(signal.SIGINT) is _on_sigint:  # unless the block replaced it
+        # put the caller's handler back (last: from here a SIGINT is the caller's), unless the
+        # block replaced ours (the command line's SIG_IGN)
+        if signal.getsignal(signal.SIGINT) in (_on_sigint, _record_late):
             signal.signal(signal.SIGINT, previous)
 
 
@@ -152,3 +165,46 @@ def raise_if_interrupted() -> None:
     """Raise ``KeyboardInterrupt`` if Ctrl-C was pressed inside :func:`watch` (and swallowed)."""
     if _seen:
         raise KeyboardInterrupt
+
+
+def _record_late(signum: int, frame: Any) -> None:
+    _late.append(signum)
+
+
+def record_interrupts() -> None:
+    """From now until the :func:`watch` block ends, record SIGINT instead of raising it.
+
+    For the end of a program whose work is done: a Ctrl-C there changes nothing
+    (:func:`late_interrupts` tells whether one came). A SIGINT that was already pending when
+    this is called is raised first (``signal.signal`` runs pending handlers before it replaces
+    them), so it counts as one that came before. Only acts inside :func:`watch` (outside it,
+    Python's own handling is left as it is) and in the main thread.
+    """
+    # outside watch() the handler is the caller's: not ours to change; other threads cannot
+    if _watching and _in_main_thread() and signal.getsignal(signal.SIGINT) is _on_sigint:
+        signal.signal(signal.SIGINT, _record_late)
+
+
+def late_interrupts() -> int:
+    """How many SIGINTs came after :func:`record_interrupts` in the current :func:`watch`."""
+    return len(_late)
+
+
+def checkpoint(name: str) -> None:
+    """A named point of a program's tail where a test may send SIGINT; a no-op otherwise.
+
+    :func:`roughbrdf.cli.main` calls it between its last statements, so that a test can inject
+    Ctrl-C at each of them deterministically instead of by timing.
+    """
+    if _checkpoint_hook:  # no hook outside tests: nothing to do
+        _checkpoint_hook[0](name)
+
+
+def set_checkpoint_hook(hook: Callable[[str], None] | None) -> Callable[[str], None] | None:
+    """Install ``hook`` (called with each :func:`checkpoint`'s name), or remove it (``None``);
+    returns the previous one. For tests only."""
+    previous = _checkpoint_hook[0] if _checkpoint_hook else None
+    _checkpoint_hook.clear()
+    if hook is not None:
+        _checkpoint_hook.append(hook)
+    return previous

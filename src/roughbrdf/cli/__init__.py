@@ -97,31 +97,62 @@ def __getattr__(name: str) -> Any:
 def main(argv: list[str] | None = None) -> int:
     """Run the command line (``argv``, default ``sys.argv[1:]``); returns the exit status.
 
-    Ctrl-C at any moment ends the run with :data:`EXIT_INTERRUPTED` and the one line
+    Ctrl-C at any moment of the run ends it with :data:`EXIT_INTERRUPTED` and the one line
     ``interrupted`` (also when a library swallowed the ``KeyboardInterrupt``:
-    :func:`roughbrdf.interrupts.watch`). As the console script (``argv`` None), a Ctrl-C that
-    comes after the command has ended is ignored: only Python's shutdown is left.
+    :func:`roughbrdf.interrupts.watch`). Once the run's status is settled (its files are
+    committed), a Ctrl-C changes nothing: :func:`main` returns that status and never raises
+    ``KeyboardInterrupt`` (:func:`roughbrdf.interrupts.record_interrupts`). As the console
+    script (``argv`` None), a Ctrl-C that comes after :func:`main` has returned is ignored: only
+    Python's shutdown is left. Called from Python, the caller's SIGINT handler is back once
+    :func:`main` returns.
     """
-    from ..interrupts import interrupted, watch
+    from ..interrupts import checkpoint, record_interrupts, watch
 
     _Run.debug = "--debug" in (sys.argv[1:] if argv is None else argv)  # until parsed
     _Run.interrupt_reported = False
     with watch():
         try:
-            code = _run(argv)
-        except KeyboardInterrupt:
+            code = _run(argv)  # returns with SIGINT recorded, never raised
+        except KeyboardInterrupt:  # only where _run did not settle (a second Ctrl-C there)
             code = EXIT_INTERRUPTED
-        if interrupted():
-            code = EXIT_INTERRUPTED
+            record_interrupts()
+        checkpoint("main: status settled")
         if code == EXIT_INTERRUPTED and not _Run.interrupt_reported:
             _say("interrupted")
+            checkpoint("main: interrupted said")
             _Run.interrupt_reported = True
+        checkpoint("main: reported")
         if argv is None:
             _ignore_sigint()
-    return code
+            checkpoint("main: SIGINT ignored")
+        return code
 
 
 def _run(argv: list[str] | None) -> int:
+    """Run the command; its exit status, settled: on return SIGINT is recorded, not raised.
+
+    A Ctrl-C that comes before the status is settled (while the command runs, or in the few
+    statements after it, which are still this function's) makes it :data:`EXIT_INTERRUPTED`.
+    """
+    from ..interrupts import checkpoint, interrupted, record_interrupts
+
+    try:
+        code = _invoke(argv)
+        checkpoint("run: command returned")
+        if interrupted():  # a Ctrl-C that a library swallowed during the command
+            code = EXIT_INTERRUPTED
+    except KeyboardInterrupt:
+        code = EXIT_INTERRUPTED
+    while True:
+        try:
+            checkpoint("run: settling")
+            record_interrupts()
+            return code
+        except KeyboardInterrupt:  # it came before the handler was replaced: try again
+            code = EXIT_INTERRUPTED
+
+
+def _invoke(argv: list[str] | None) -> int:
     """Build the application and run it in standalone mode; its exit status."""
     try:
         get_app()(args=argv, prog_name="roughbrdf")

@@ -30,16 +30,21 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ArgumentError
+from ..output import LOCK, MANIFEST
 from .resume import completed_rows, file_sha256, fingerprint
 from .tasks import Task
 
 __all__ = ["fit_catalogue", "CatalogueResult", "expand_inputs", "folder_names",
-           "CATALOGUE_FILES"]
+           "check_options", "CATALOGUE_FILES", "RESERVED"]
 
 #: the catalogue's own files in its folder
 CATALOGUE_FILES = ("catalogue.csv", "catalogue.json")
 #: the files of the summary page (:mod:`roughbrdf.catalogue.summary`, when it exists)
 SUMMARY_FILES = ("summary.md", "summary.html")
+#: names no fit folder may take: the catalogue's own entries (and its manifest and lock)
+RESERVED = (*CATALOGUE_FILES, *SUMMARY_FILES, MANIFEST, LOCK)
+#: the longest fit folder stem, in UTF-8 bytes (a "-N" suffix still fits in 255)
+MAX_NAME = 200
 
 
 @dataclass
@@ -110,19 +115,54 @@ def expand_inputs(inputs: str | os.PathLike | Iterable[str | os.PathLike]) -> li
 def folder_names(files: list[str]) -> list[str]:
     """One fit folder name per file: its stem, made unique with ``-2``, ``-3`` ...
 
+    Every name is chosen against every name already used, compared case-insensitively
+    (Unicode NFC + casefold: the catalogue may lie on, or be copied to, a file system that folds
+    case): the stems of the other inputs, the generated ``-N`` names and the catalogue's own
+    entries (:data:`RESERVED`). A stem is kept as it is when it is free (today's names, so that
+    existing catalogues resume). Characters other than letters, digits, ``-``, ``_`` and ``.``
+    become ``_``; leading and trailing dots are dropped (never ``.``, ``..`` nor a hidden
+    name); an empty stem becomes ``input``; a stem is cut to :data:`MAX_NAME` UTF-8 bytes. The
+    names depend only on the list of inputs (the same list gives the same names).
+
     Examples
     --------
     >>> folder_names(["a/x.csv", "b/x.csv", "y.astm"])
     ['x', 'x-2', 'y']
+    >>> folder_names(["a.astm", "a.csv", "a-2.astm", "A.astm", "..astm", "catalogue.csv.csv"])
+    ['a', 'a-3', 'a-2', 'A-4', 'input', 'catalogue.csv-2']
     """
-    used: dict[str, int] = {}
-    names = []
-    for f in files:
-        stem = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in Path(f).stem)
-        stem = stem or "input"
-        used[stem] = used.get(stem, 0) + 1
-        names.append(stem if used[stem] == 1 else f"{stem}-{used[stem]}")
-    return names
+    stems = [_clean_stem(Path(f).name) for f in files]
+    taken = {_fold(n) for n in RESERVED}
+    names: list[str | None] = [None] * len(files)
+    for k, stem in enumerate(stems):  # first pass: every stem that is free keeps its name
+        if _fold(stem) not in taken:
+            taken.add(_fold(stem))
+            names[k] = stem
+    for k, stem in enumerate(stems):  # then the repeats: the first free -N of their stem
+        if names[k] is None:
+            n = 2
+            while _fold(f"{stem}-{n}") in taken:
+                n += 1
+            taken.add(_fold(f"{stem}-{n}"))
+            names[k] = f"{stem}-{n}"
+    return [str(n) for n in names]
+
+
+def _clean_stem(filename: str) -> str:
+    """The folder stem of an input file's name (see :func:`folder_names`)."""
+    stem = Path(filename).stem if filename not in (".", "..") else ""
+    stem = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in stem)
+    stem = stem.strip(".")  # ".", "..", hidden names (".roughbrdf-lock"), Windows' "a."
+    while len(stem.encode()) > MAX_NAME:  # a folder name has at most 255 bytes
+        stem = stem[:-1]
+    return stem.rstrip(".") or "input"
+
+
+def _fold(name: str) -> str:
+    """``name`` as a case-folding file system compares it."""
+    import unicodedata
+
+    return unicodedata.normalize("NFC", name).casefold()
 
 
 def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model: Any,
@@ -189,6 +229,8 @@ def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model
     if client is not None and scheduler is not None:
         raise ArgumentError("scheduler", "give either a client or a scheduler address",
                             value=scheduler)
+    check_options(model, fit_options, read_options=read_options, time_limit=time_limit,
+                  retries=retries, n_workers=n_workers)
     files = expand_inputs(inputs)
     out = Path(out_dir)
     opts = {"fit": fit_options, "read": dict(read_options or {}), "plots": plots,
@@ -230,6 +272,117 @@ def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model
         written += [Path(p) for p in summary.write_summary(out, rows,
                                                            overwrite=overwrite or resume)]
     return CatalogueResult(rows=rows, out_dir=out, written=written)
+
+
+def check_options(model: Any, fit_options: Mapping[str, Any], *,
+                  read_options: Mapping[str, Any] | None = None, time_limit: float | None = None,
+                  retries: int = 1, n_workers: int | None = None) -> None:
+    """Check the options of :func:`fit_catalogue` once, before any cluster starts.
+
+    Every option that a worker would reject for *any* file raises here
+    (:class:`~roughbrdf.errors.ArgumentError` naming the argument), instead of failing each
+    file on the workers: unknown keywords of :func:`roughbrdf.fit`, and the checks of
+    :class:`roughbrdf.fitting.setup.FitPlan` (loss, starts, seed, subsample, fix, bounds,
+    aperture, fit domain ...) run on a small stand-in measurement, without fitting. Options
+    whose validity depends on the file (a channel label, ``quantity=`` against what the file
+    says) are left to the task.
+
+    Examples
+    --------
+    >>> check_options("tr75", {"starts": 0})
+    Traceback (most recent call last):
+    ...
+    roughbrdf.errors.ArgumentError: starts must be >= 1 (an integer), got 0
+    """
+    import inspect
+
+    from .. import fitting
+
+    _check_run_options(time_limit, retries, n_workers)
+    if read_options:
+        _check_read_options(read_options)
+    known = inspect.signature(fitting.fit).parameters
+    for name in fit_options:  # a misspelt keyword: TypeError on every worker otherwise
+        if name not in known or name in ("model", "measurement", "progress"):
+            raise ArgumentError(name, f"{name}= is not an option of roughbrdf.fit (known: "
+                                f"{', '.join(sorted(set(known) - {'model', 'measurement'}))})")
+    opts = {n: p.default for n, p in known.items() if p.default is not inspect.Parameter.empty}
+    opts.update(fit_options)
+    seed = opts["seed"]
+    # numpy's generators refuse a negative seed ("expected non-negative integer") on the worker
+    if seed is not None and not isinstance(seed, bool) and isinstance(seed, int) and seed < 0:
+        raise ArgumentError("seed", "must be None or an integer >= 0", value=seed)
+    _check_channel(opts["channel"])
+    if not isinstance(opts["joint"], bool):  # rb.fit checks it only after reading the data
+        raise ArgumentError("joint", "must be True or False", value=opts["joint"])
+    if opts["shared"] is not None and not opts["joint"]:
+        raise ArgumentError("shared", "only a joint fit shares parameters: ask for one with "
+                            "joint=True (command line: --joint)", value=opts["shared"])
+    _check_plan(model, opts)
+
+
+def _check_plan(model: Any, opts: dict[str, Any]) -> None:
+    """:class:`~roughbrdf.fitting.setup.FitPlan`'s checks of ``opts`` on a stand-in
+    measurement (a few directions; relative data when ``relative_to`` is given)."""
+    import inspect
+
+    import numpy as np
+
+    from ..fitting.setup import FitPlan, as_model
+    from ..measurement import Measurement
+    from ..quantity import Quantity
+
+    auto = isinstance(model, str) and model.strip().lower() == "auto"
+    if auto:
+        for name in ("fix", "bounds"):  # as fit_auto: the candidates' parameters differ
+            if opts.get(name):
+                raise ArgumentError(name, "names parameters of one model; with model 'auto' "
+                                    "the candidates have different parameters: choose the "
+                                    "model", value=opts[name])
+        # the other options do not depend on the model: a stand-in candidate checks them
+        opts = {**opts, "fix": (), "bounds": None}
+    m = as_model("lambertian" if auto else model)
+    t = np.radians(np.array([10.0, 20.0, 30.0, 40.0]))
+    probe = Measurement(t, t, np.zeros(4), np.ones(4), quantity=Quantity.parse(
+        "relative" if opts.get("relative_to") else "brdf"))
+    wanted = inspect.signature(FitPlan.of).parameters
+    FitPlan.of(m, probe, **{k: v for k, v in opts.items()
+                            if k in wanted and k not in ("model", "measurement")})
+
+
+def _check_run_options(time_limit: float | None, retries: Any, n_workers: Any) -> None:
+    """``time_limit``, ``retries`` and ``n_workers`` of :func:`fit_catalogue`."""
+    if time_limit is not None and (isinstance(time_limit, bool)
+                                   or not isinstance(time_limit, int | float)
+                                   or not time_limit > 0):
+        raise ArgumentError("time_limit", "must be a number of seconds > 0", value=time_limit)
+    if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
+        raise ArgumentError("retries", "must be a whole number >= 0", value=retries)
+    if n_workers is not None and (isinstance(n_workers, bool) or not isinstance(n_workers, int)
+                                  or n_workers < 1):
+        raise ArgumentError("n_workers", "must be a whole number >= 1", value=n_workers)
+
+
+def _check_read_options(read_options: Mapping[str, Any]) -> None:
+    """``format`` and ``quantity`` of :func:`roughbrdf.read` (their form; whether a file
+    agrees with them is the file's business)."""
+    from ..io import format_for
+    from ..quantity import Quantity
+
+    if read_options.get("format") is not None:
+        format_for("input", read_options["format"])
+    if read_options.get("quantity") is not None:
+        Quantity.parse(read_options["quantity"], "quantity")
+
+
+def _check_channel(channel: Any) -> None:
+    """``channel``: None, a label or position, or a list of them (which ones exist depends on
+    the file)."""
+    items = channel if isinstance(channel, list | tuple) else [channel]
+    if channel is not None and (not items or not all(
+            isinstance(c, str | int) and not isinstance(c, bool) for c in items)):
+        raise ArgumentError("channel", "must be a channel label or position, or a list of "
+                            "them", value=channel)
 
 
 def _label(model: Any) -> str:

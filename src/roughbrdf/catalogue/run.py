@@ -16,43 +16,50 @@ import contextlib
 import os
 import time
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 from .rows import failed_row
 from .tasks import Task, run_task
 
-__all__ = ["run_tasks", "connect"]
+__all__ = ["run_tasks", "connect", "start_local", "STARTED_HOOKS", "CONNECTED_HOOKS"]
 
 #: seconds between two looks at the running tasks (time limits, progress)
 POLL = 0.2
 
 
+#: called with the cluster object once a local cluster is up, before the client connects
+#: (test and tool hooks: a fault injected at the start)
+STARTED_HOOKS: list[Callable[[Any], None]] = []
+#: called with the client once it is connected, before any task is submitted
+CONNECTED_HOOKS: list[Callable[[Any], None]] = []
+
+
 @contextlib.contextmanager
 def connect(client: Any = None, scheduler: str | None = None,
             n_workers: int | None = None, n_tasks: int = 1) -> Iterator[tuple[Any, bool]]:
-    """A ``distributed.Client``: ``client`` itself, one to ``scheduler``, or one to a new
-    ``LocalCluster`` (closed on exit); yields ``(client, local)`` (local: a cluster of ours)."""
+    """A ``distributed.Client``: ``client`` itself, one to ``scheduler``, or one to a new local
+    cluster (:func:`start_local`, closed on exit); yields ``(client, local)`` (local: a cluster
+    of ours)."""
     if client is not None:
         yield client, False
         return
     from distributed import Client
 
-    if scheduler is not None:
+    if scheduler is not None:  # that cluster's own security applies (its config or loader)
         with Client(scheduler, timeout="20s") as c:
+            _call(CONNECTED_HOOKS, c)
             yield c, False
         return
-    from distributed import LocalCluster
-
-    from .worker import WORKER_ENV
-
     if n_workers is not None and (not isinstance(n_workers, int) or n_workers < 1):
         from ..errors import ArgumentError
 
         raise ArgumentError("n_workers", "must be a whole number >= 1", value=n_workers)
     n = n_workers or max(1, min(os.cpu_count() or 1, n_tasks))
     import dask
+
+    from .worker import WORKER_ENV
 
     spawn = {**dask.config.get("distributed.nanny.pre-spawn-environ", {}), **WORKER_ENV}
     # distributed's nannies apply pre-spawn-environ to *this* process's os.environ before they
@@ -61,20 +68,88 @@ def connect(client: Any = None, scheduler: str | None = None,
     # value"); the caller's environment is put back once the workers are up and at the end
     saved = {k: os.environ.get(k) for k in spawn}
     try:
-        # the workers' own log lines (e.g. tasks cancelled by Ctrl-C) are not the user's
-        # business
-        with dask.config.set({"distributed.nanny.pre-spawn-environ": spawn,
-                              "logging.distributed": "error"}):
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                   dashboard_address=None, env=WORKER_ENV)
-        _restore_environ(saved)
+        mask = _block_sigint()  # see start_local; put back inside the try that closes it
         try:
-            with Client(cluster) as c:
+            cluster = start_local(n, spawn)
+        except BaseException:
+            _unblock(mask)
+            raise
+        try:
+            _unblock(mask)  # a Ctrl-C of the start-up is raised here: the cluster is closed
+            _restore_environ(saved)
+            _call(STARTED_HOOKS, cluster)
+            with Client(cluster, security=cluster.security) as c:
+                _call(CONNECTED_HOOKS, c)
                 yield c, True
         finally:
             cluster.close()
     finally:
         _restore_environ(saved)
+
+
+def start_local(n: int, spawn: dict[str, str]) -> Any:
+    """A local cluster of ``n`` single-threaded worker processes, for this user only.
+
+    * TLS with temporary credentials (``Security.temporary()``: a certificate made for this
+      cluster and held in memory): without them no other process, another user's included,
+      can connect to the scheduler or the workers and run code as this user; everything
+      listens on 127.0.0.1 only;
+    * no HTTP server (:class:`~roughbrdf.catalogue.worker.QuietScheduler`), so no port 8787
+      and no warning when it is taken;
+    * the workers' statistical profiler off (its call stacks grow the workers' memory);
+    * SIGINT blocked in the worker processes from their first instruction, when the caller
+      blocks it in this thread during the call (:func:`connect` does): Ctrl-C in a terminal
+      reaches the whole process group, and a worker still starting would print its
+      traceback. The mask is inherited by the threads the cluster starts (its event loop, the
+      nannies' process threads) and by the processes they spawn; :func:`connect` puts its
+      own mask back once the cluster is up, so a Ctrl-C of the start-up is seen then.
+    """
+    import logging
+
+    import dask
+    from distributed import SpecCluster
+    from distributed.security import Security
+    from distributed.worker_memory import parse_memory_limit
+
+    from .worker import WORKER_ENV, QuietNanny, QuietScheduler
+
+    security = Security.temporary()
+    common = {"host": "127.0.0.1", "protocol": "tls://", "security": security}
+    scheduler = {"cls": QuietScheduler,
+                 "options": {**common, "port": 0, "dashboard": False, "dashboard_address": None}}
+    worker = {"cls": QuietNanny,
+              "options": {**common, "nthreads": 1, "env": WORKER_ENV, "dashboard": False,
+                          "memory_limit": parse_memory_limit(
+                              "auto", 1, n, logger=logging.getLogger("distributed")),
+                          "silence_logs": logging.ERROR}}
+    config = {"distributed.nanny.pre-spawn-environ": spawn,
+              "distributed.worker.profile.enabled": False,
+              "logging.distributed": "error"}  # the workers' own log lines are not the user's
+    with dask.config.set(config):
+        return SpecCluster(scheduler=scheduler, workers={i: worker for i in range(n)},
+                           worker=worker, security=security, silence_logs=logging.ERROR)
+
+
+def _block_sigint() -> Any:
+    """Block SIGINT in this thread; the previous mask (None where signal masks do not exist)."""
+    import signal
+
+    if not hasattr(signal, "pthread_sigmask"):  # Windows: no signal masks (and no SIGINT to
+        return None                             # the process group either)
+    return signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+
+
+def _unblock(mask: Any) -> None:
+    """Put back the signal mask that :func:`_block_sigint` returned."""
+    import signal
+
+    if mask is not None:
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+
+
+def _call(hooks: list[Callable[[Any], None]], arg: Any) -> None:
+    for hook in list(hooks):
+        hook(arg)
 
 
 def _restore_environ(saved: dict[str, str | None]) -> None:

@@ -71,8 +71,44 @@ def read_options(quantity: str | None, angles_in: str | None,
     if unit is not None:
         opts["angles"] = unit
     if file_format:
+        from ..io import FORMATS, format_for
+
+        try:  # every worker would refuse the files otherwise, one failure each
+            format_for("input", file_format)
+        except ValueError:
+            raise ValueError(f"--format: unknown value {file_format!r} (choose from "
+                             f"{', '.join(FORMATS)})") from None
         opts["format"] = file_format
     return opts
+
+
+def check_search(starts: int, loss: str, seed: int, relative_to: str | None = None) -> None:
+    """``--starts``, ``--loss``, ``--seed`` and ``--relative-to`` in the terms of the command
+    line, before any cluster starts (the library's own check,
+    :func:`roughbrdf.catalogue.check_options`, words them for Python and runs next, for every
+    other option).
+
+    Examples
+    --------
+    >>> check_search(0, "relative", 0)
+    Traceback (most recent call last):
+    ...
+    ValueError: --starts must be >= 1 (got 0)
+    """
+    from ..quantity import LOSSES, Quantity
+
+    if starts < 1:
+        raise ValueError(f"--starts must be >= 1 (got {starts})")
+    if loss not in LOSSES:
+        raise ValueError(f"--loss: unknown value {loss!r} (choose from {', '.join(LOSSES)})")
+    if seed < 0:  # numpy's generators take no negative seed
+        raise ValueError(f"--seed must be >= 0 (got {seed})")
+    if relative_to is not None:
+        try:  # what a relative file's values are proportional to (fitting.data.Comparison)
+            Quantity.RELATIVE.compared_with(relative_to)
+        except ValueError:
+            raise ValueError(f"--relative-to: unknown value {relative_to!r} (choose from brdf, "
+                             f"bridf)") from None
 
 
 def run_batch(paths: list[str], model: str, out: str, *, param: list[str] | None,
@@ -98,7 +134,11 @@ def run_batch(paths: list[str], model: str, out: str, *, param: list[str] | None
         raise ValueError("--workers sets the size of a local cluster; with --scheduler the "
                          "cluster's own workers run the fits: give one of them")
     if workers is not None and workers < 1:
-        raise ValueError(f"--workers must be >= 1, got {workers}")
+        raise ValueError(f"--workers must be >= 1 (got {workers})")
+    if time_limit is not None and not time_limit > 0:  # also NaN
+        raise ValueError(f"--time-limit must be a number of seconds > 0 (got {time_limit:g})")
+    check_search(fit_options["starts"], fit_options["loss"], fit_options["seed"],
+                 fit_options["relative_to"])
     t_max, excl = fit_domain(theta_r_max, source_exclusion)
     auto = model.strip().lower() == "auto"
     auto_options(models, param, fix, bounds, auto)

@@ -135,12 +135,21 @@ def test_empty_and_odd_rows(tmp_path: Path) -> None:
 
 def test_hundred_thousand_rows_stay_small(tmp_path: Path) -> None:
     rows = make_rows(100_000)
-    t0 = time.perf_counter()
     _, html_path = write_summary(tmp_path, rows, max_thumbnails=60)
-    elapsed = time.perf_counter() - t0
     size = html_path.stat().st_size
     assert size < 200 * len(rows), size                     # measured: 11.2 MB (112 B a row)
-    assert elapsed < 20, elapsed
+    # paged: the rows are data, once (columns, strings through dictionaries); the browser
+    # renders one page of them, so the page's markup does not grow with the rows (its time to
+    # write and to open: benchmarks/bench_suite_figures.py)
+    page = html_path.read_text(encoding="utf-8")
+    _, small = write_summary(tmp_path / "small", make_rows(10), max_thumbnails=60)
+    markup = small.read_text(encoding="utf-8")
+    for tag in ("<tr", "<td", "<a ", "<img"):
+        assert page.count(tag) == markup.count(tag), tag
+    data = _page_data(page)
+    assert data["pageSize"] == 100
+    assert all(len(col) == len(rows) for col in data["data"]) and len(data["links"]) == len(rows)
+    assert len(data["dicts"]["file"]) == 50_000             # each file name once
     md = (tmp_path / "summary.md").read_text()
     assert "## Fits (first 100 of 100000)" in md and len(md) < 500_000
     assert "| failed | 10000 |" in md and "- … and 9900 more" in md
@@ -175,12 +184,19 @@ def browser() -> Iterator[Any]:
         shutil.rmtree(profile, ignore_errors=True)
 
 
+#: seconds the page's script may take before the test counts it as hung (not a speed figure:
+#: benchmarks/bench_suite_figures.py measures that)
+HANG = 300
+
+
 def _open(driver: Any, path: Path) -> None:
     driver.get(path.resolve().as_uri())
-    deadline = time.monotonic() + 20
-    while driver.execute_script("return document.body.dataset.ready") != "1":
-        assert time.monotonic() < deadline, "the page's script did not finish"
+    give_up = time.monotonic() + HANG
+    while (ready := driver.execute_script("return document.body.dataset.ready")) != "1":
+        if time.monotonic() > give_up:  # hung: stop waiting
+            break
         time.sleep(0.05)
+    assert ready == "1", "the page's script did not finish"
 
 
 def _column(driver: Any, index: int) -> list[str]:
@@ -231,16 +247,18 @@ def test_browser_hundred_thousand_rows(browser: Any, tmp_path: Path) -> None:
     rows = make_rows(100_000)
     _, page = write_summary(tmp_path, rows)
     browser.get_log("browser")
-    t0 = time.perf_counter()
     _open(browser, page)
-    opened = time.perf_counter() - t0
+    # paged: the DOM holds one page of rows, not 100000 (the times: benchmarks/)
     assert len(browser.find_elements("css selector", "#rb-table tbody tr")) == 100
+    elements = browser.execute_script("return document.getElementsByTagName('*').length")
+    assert elements < 10_000, elements                     # 100000 rows: over a million
     assert browser.find_element("id", "rb-info").text.endswith("of 100000 (page 1 of 1000)")
     headers = [h.text for h in browser.find_elements("css selector", "#rb-table th")]
-    t0 = time.perf_counter()
     browser.find_elements("css selector", "#rb-table th")[headers.index("rms log")].click()
-    sorted_in = time.perf_counter() - t0
     vals = [float(v) for v in _column(browser, headers.index("rms log"))]
     assert vals == sorted(vals) and len(vals) == 100
-    assert opened < 15 and sorted_in < 5, (opened, sorted_in)
+    # all 100000 rows were sorted, not the page shown: the first is the smallest of them all
+    smallest = min(r["rms_log"] for r in rows if r["rms_log"] is not None)
+    assert vals[0] == pytest.approx(smallest, rel=1e-3), (vals[0], smallest)
+    assert len(browser.find_elements("css selector", "#rb-table tbody tr")) == 100
     assert _severe(browser) == []

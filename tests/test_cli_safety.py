@@ -7,8 +7,10 @@ Times printed by the signal test (``pytest -s``) are figures for the docs, not a
 from __future__ import annotations
 
 import errno
+import inspect
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -20,7 +22,7 @@ from typer.testing import CliRunner
 
 from roughbrdf.cli import app, main
 from roughbrdf.demo import default_measurement_path
-from roughbrdf.output import LOCK, MANIFEST, TMP_PREFIX
+from roughbrdf.output import JOURNAL, LOCK, MANIFEST, TMP_PREFIX, file_sha256, read_manifest
 
 runner = CliRunner()
 DEFAULT = default_measurement_path()
@@ -40,11 +42,14 @@ def _snapshot(folder) -> dict[str, bytes]:
 def _state(folder, old: dict[str, bytes]) -> str:
     """``"old"`` or ``"new"`` for a complete result set; fails for anything else."""
     files = _snapshot(folder)
-    assert not [n for n in files if n.startswith(TMP_PREFIX) or n == LOCK], sorted(files)
+    assert not [n for n in files if n.startswith(TMP_PREFIX) or n in (LOCK, JOURNAL)], \
+        sorted(files)
     if files == old:
         return "old"
     assert set(files) == set(old), sorted(files)  # the same command writes the same names
-    assert json.loads(files[MANIFEST]) == sorted(n for n in files if n != MANIFEST)
+    listed = read_manifest(folder)  # {name: sha256} of the files the set holds
+    assert sorted(listed) == sorted(n for n in files if n != MANIFEST)
+    assert all(digest in (None, file_sha256(folder / n)) for n, digest in listed.items())
     assert json.loads(files["fit.json"])["channels"]
     assert files["report.txt"].startswith(b"[[Fit]]")
     assert all(files[n].startswith(PNG) for n in files if n.endswith(".png"))
@@ -73,7 +78,9 @@ def _finish(p: subprocess.Popen) -> tuple[str, str]:
 def test_ctrl_c_at_any_moment_of_a_fit_leaves_old_or_new_results(tmp_path):
     """SIGINT from start to finish of ``roughbrdf fit --force`` into a folder holding a complete
     earlier result: exit 130 and ``interrupted`` (0 if it had finished), and the folder holds
-    the old set or the new one, complete, never a mix or a leftover."""
+    the old set or the new one, complete, never a mix or a leftover. The instants are only a
+    spread: what is checked holds at whatever instant the signal lands
+    (:func:`_allowed_outcome`); ``tests/test_cli_interrupts.py`` places it deterministically."""
     base = tmp_path / "base"
     t0 = time.monotonic()
     first = subprocess.run([*CLI, *FIT, "--out", str(base)], capture_output=True, text=True,
@@ -95,19 +102,42 @@ def test_ctrl_c_at_any_moment_of_a_fit_leaves_old_or_new_results(tmp_path):
         ended = time.monotonic() - t_signal
         state = _state(out, old)
         figures.append((moment, p.returncode, round(ended, 2), state))
-        if p.returncode == 130:
-            assert _one_line(stderr) == "interrupted" and stderr.strip() == "interrupted"
-        elif p.returncode == 0:
-            assert state == "new", figures
-        elif p.returncode in (-signal.SIGINT, 1) and moment == 0.05:
-            # before roughbrdf's first line runs (Python starting up, `import roughbrdf`: about
-            # 40 ms), Python's own default applies: it dies of the signal (shell status 130),
-            # or exits 1 if its start-up was cut; nothing can have been written
-            assert state == "old" and not stdout, figures
-        else:
-            pytest.fail(f"exit status {p.returncode} at {moment}: {stderr}")
+        _allowed_outcome(p.returncode, stdout, stderr, state, figures)
     print(f"\nfit takes {duration:.2f} s; (moment, status, ended s after SIGINT, folder):",
           *figures, sep="\n  ")
+
+
+#: the line of ``with watch():`` in roughbrdf.cli.main: from there on SIGINT is roughbrdf's
+_WATCH_LINE = next(i for i, text in enumerate(inspect.getsourcelines(main)[0],
+                                             start=main.__code__.co_firstlineno)
+                   if text.strip().startswith("with watch()"))
+
+
+def _allowed_outcome(code: int, stdout: str, stderr: str, state: str, figures: list) -> None:
+    """The outcomes allowed at whatever instant the signal landed (a loaded machine shifts
+    every instant, so none is tied to a moment): ``_state`` has already checked that the
+    folder holds the old set or the new one, complete.
+
+    * 130 and the one line ``interrupted``: the old set, or the new one if the signal came
+      after the commit but before the run's status was settled;
+    * 0: the signal came once the run was over (or the run ended before it): the new set;
+    * death by the signal (or 1, Python's start-up cut): only before roughbrdf's handler is in
+      place (Python starting up, ``import roughbrdf``; about 40 ms on an idle machine, longer
+      on a loaded one). Nothing can have been written then: the old set, no output, and a
+      traceback, if Python printed one, passes through :func:`main` (if at all) only above
+      its ``with watch():`` line, where the handler is installed.
+    """
+    if code == 130:
+        assert stderr.strip() == "interrupted", (stderr, figures)
+    elif code == 0:
+        assert state == "new" and "Traceback" not in stderr, (stderr, figures)
+        assert "interrupted" not in stderr, (stderr, figures)
+    elif code in (-signal.SIGINT, 1):
+        assert state == "old" and not stdout, (stdout, stderr, figures)
+        in_main = re.findall(r'cli[/\\]__init__\.py", line (\d+), in main\b', stderr)
+        assert all(int(n) < _WATCH_LINE for n in in_main), (stderr, figures)
+    else:
+        pytest.fail(f"exit status {code}: {stderr} {figures}")
 
 
 def _wait_for(moment: float | str, p: subprocess.Popen, out) -> None:

@@ -25,6 +25,16 @@ twice and two declarations that disagree are :class:`FormatError` naming both pl
 that ends inside a number without a final line end is read with an
 :class:`UnterminatedRowWarning`.
 
+The text readers read each data row field by field: an empty field, a blank inside a number
+(``1 5``), an underscore (``1_5``) or a non-ASCII digit (``１５``) is a :class:`FormatError`
+naming the line and the column (numbers are plain ASCII: sign, digits, point, exponent,
+``nan``, ``inf``). Angles that look like the other unit - every zenith below 2 read as degrees
+(a radians file), an angle above 2 pi read as radians - are read as told, with an
+:class:`ImplausibleAnglesWarning` naming the ``angles=`` option to use. A UTF-16 or UTF-32 file
+with a byte-order mark is read; one without (NUL bytes) is refused, saying so. A pipe or device
+(not a regular file) is read up to 1 GiB (``roughbrdf.io._rows.MAX_STREAM_BYTES``) and refused
+beyond, naming the file and the limit.
+
 ``write(m, path)`` never replaces an existing file unless ``overwrite=True`` (the CLI's
 ``--force``), never writes onto the file ``m`` was read from, and writes atomically (a temporary
 file renamed over ``path``: an error or Ctrl-C leaves the old file or none). Written in its own
@@ -47,10 +57,16 @@ from typing import Any
 
 from ..extrapolation import mark_extrapolated
 from ..measurement import Measurement
-from ._common import FormatError, FormatWarning, LossyWriteWarning, UnterminatedRowWarning
+from ._common import (
+    FormatError,
+    FormatWarning,
+    ImplausibleAnglesWarning,
+    LossyWriteWarning,
+    UnterminatedRowWarning,
+)
 
-__all__ = ["read", "write", "FormatError", "FormatWarning", "LossyWriteWarning",
-           "UnterminatedRowWarning", "FORMATS", "format_for"]
+__all__ = ["read", "write", "FormatError", "FormatWarning", "ImplausibleAnglesWarning",
+           "LossyWriteWarning", "UnterminatedRowWarning", "FORMATS", "format_for"]
 
 #: format name -> module name under roughbrdf.io
 FORMATS = {"astm": "astm", "alta": "alta", "merl": "merl", "csv": "csv", "zemax": "zemax"}

@@ -5,14 +5,21 @@ A text reader's ``read()`` is a short sequence of phases, each reading one part 
 
 1. **header** - the keywords / metadata lines before the data (format specific);
 2. **units** - the angle unit: :func:`resolve_angle_unit` chooses among the ``angles=`` option,
-   the file's declarations (:class:`UnitClaim`) and the format's default;
+   the file's declarations (:class:`UnitClaim`) and the format's default; once the angles are
+   read, :func:`warn_implausible_angles` warns (:class:`ImplausibleAnglesWarning`) when they
+   look like the other unit (every zenith below 2 read as degrees, an angle above 2 pi read as
+   radians);
 3. **columns** - which column holds what (format specific);
 4. **quantity** - what the values hold: :func:`resolve_quantity` chooses among the
    ``quantity=`` option, the file's declarations (:class:`QuantityClaim`) and the format's
    default;
 5. **rows** - the numbers: :func:`data_lines` collects them with their line numbers,
-   :func:`parse_rows` converts them (naming the first bad line), :func:`check_zenith_rows` and
-   :func:`azimuth_rows` check the angle columns;
+   :func:`roughbrdf.io._rows.parse_rows` converts them (checked row by row, naming the first
+   bad line and column), :func:`check_zenith_rows` and :func:`azimuth_rows` check the angle
+   columns;
+
+The file's text (encodings, a bounded read of pipes and devices) and the rows' numbers are
+read by :mod:`roughbrdf.io._rows` (``read_text``, ``begin_read``, ``parse_rows``).
 
 and ends in a :class:`~roughbrdf.measurement.Measurement`. Every problem is a
 :class:`FormatError` naming the file and, where one line is at fault, the line; a header key
@@ -46,11 +53,12 @@ from ..output import same_file, staged
 from ..quantity import Quantity
 
 __all__ = ["FormatError", "FormatWarning", "LossyWriteWarning", "UnterminatedRowWarning",
-           "read_text", "begin_read", "add_key", "data_lines", "parse_rows",
+           "ImplausibleAnglesWarning", "outside_stacklevel", "add_key", "data_lines",
            "check_zenith_rows", "azimuth_rows", "common_frame_from_spherical", "angle_factor",
-           "AngleUnit", "UnitClaim", "resolve_angle_unit", "QuantityClaim", "resolve_quantity",
-           "check_fixed_units", "prepare_target", "write_table", "warn_not_written",
-           "header_not_written", "describe_keys", "write_bytes", "LAYOUT"]
+           "AngleUnit", "UnitClaim", "resolve_angle_unit", "warn_implausible_angles",
+           "QuantityClaim", "resolve_quantity", "check_fixed_units", "prepare_target",
+           "write_table", "warn_not_written", "header_not_written", "describe_keys",
+           "write_bytes", "LAYOUT"]
 
 HALF_PI = 0.5 * math.pi
 #: angles this far beyond pi/2 (radians) are rounding in the file and are clipped to pi/2
@@ -85,12 +93,19 @@ class UnterminatedRowWarning(FormatWarning):
     the file and the line."""
 
 
+class ImplausibleAnglesWarning(FormatWarning):
+    """A file's angles look like the other unit: read as degrees, every zenith angle is below
+    2 deg (radians, whose zeniths end at 1.57, read as degrees); read as radians, an angle is
+    above 2 pi (degrees). The file is read as told; the message names the file, the largest
+    angle, where the unit came from and the ``angles=`` option to use."""
+
+
 class LossyWriteWarning(FormatWarning):
     """A writer had no place in the target format for part of the measurement (header keys of
     the source file, uncertainties...); the message names each of them."""
 
 
-def _outside_stacklevel() -> int:
+def outside_stacklevel() -> int:
     """``stacklevel`` for :func:`warnings.warn`, called from the function that warns, pointing
     at the first caller outside roughbrdf (the user's line, not the reader's)."""
     frame = sys._getframe(2)
@@ -100,47 +115,6 @@ def _outside_stacklevel() -> int:
         frame = frame.f_back  # type: ignore[assignment]
         level += 1
     return level
-
-
-#: characters a number can end with: a file ending on one of them may end inside a number
-_NUMBER_END = frozenset("0123456789.")
-
-
-def read_text(path: str | os.PathLike) -> list[str]:
-    """The file's lines (no line ends). Undecodable bytes become U+FFFD instead of failing.
-
-    Warns (:class:`UnterminatedRowWarning`) when the file ends inside a number without a final
-    line end.
-    """
-    p = Path(path)
-    if not p.exists():
-        raise FileNotFoundError(f"{p}: no such file")
-    if p.is_dir():
-        raise FormatError("is a directory, not a measurement file", p)
-    with open(p, encoding="utf-8-sig", errors="replace", newline=None) as fh:
-        text = fh.read()
-    lines = text.splitlines()
-    if lines and text[-1] in _NUMBER_END and not lines[-1].lstrip().startswith("#"):
-        tail = lines[-1].strip()[-24:]
-        warnings.warn(f"{p}, line {len(lines)}: the file ends inside a number without a line "
-                      f"end (...{tail!r}); the row is read, but its last number may be cut "
-                      "short - check that the file is complete", UnterminatedRowWarning,
-                      stacklevel=_outside_stacklevel())
-    return lines
-
-
-def begin_read(fmt: str, path: str | os.PathLike, options: dict, quantity: object = None
-               ) -> tuple[Path, list[str]]:
-    """Shared start of the text readers: reject unknown options and quantities, read the lines.
-
-    Raises ``TypeError`` for an unknown option and ``ValueError`` (from
-    :meth:`~roughbrdf.quantity.Quantity.parse`) for a ``quantity=`` that is not a quantity.
-    """
-    if options:
-        raise TypeError(f"{fmt}.read got unknown options {sorted(options)}")
-    if quantity is not None:
-        Quantity.parse(quantity, "quantity")
-    return Path(path), read_text(path)
 
 
 def add_key(keys: dict[str, str], lines: dict[str, int], key: str, value: str, line: int,
@@ -174,69 +148,6 @@ def data_lines(lines: list[str], start: int, *, comments: str | tuple[str, ...] 
             texts.append(s)
             linenos.append(i + 1)
     return texts, linenos
-
-
-def _is_number(tok: str) -> bool:
-    try:
-        float(tok)
-    except ValueError:
-        return False
-    return True
-
-
-def split_fields(text: str, sep: str | None) -> list[str]:
-    """Fields of one data line (``sep`` ``","`` or None for whitespace)."""
-    if sep is None:
-        return text.split()
-    return [f.strip() for f in text.split(sep)]
-
-
-def parse_rows(texts: list[str], linenos: list[int] | np.ndarray, ncols: int | tuple[int, ...],
-               path, sep: str | None = None, what: str = "values") -> np.ndarray:
-    """Parse data lines into a float array (n, ncols) fast, or raise a FormatError naming the line.
-
-    ``ncols`` may be a tuple of accepted column counts (all rows must then share one).
-    The fast path joins all lines and converts once with NumPy; only on failure are the lines
-    examined one by one to name the first bad one.
-    """
-    accepted = (ncols,) if isinstance(ncols, int) else tuple(ncols)
-    n = len(texts)
-    if n == 0:
-        return np.empty((0, accepted[0]))
-    if sep is None:
-        counts = np.fromiter((len(t.split()) for t in texts), dtype=np.int64, count=n)
-    else:
-        counts = np.fromiter((t.count(sep) for t in texts), dtype=np.int64, count=n) + 1
-    first = int(counts[0])
-    if first not in accepted:
-        exp = " or ".join(str(a) for a in accepted)
-        raise FormatError(f"expected {exp} {what} per row, found {first}: {texts[0].strip()!r}",
-                          path, int(linenos[0]))
-    bad = np.flatnonzero(counts != first)
-    if bad.size:
-        k = int(bad[0])
-        raise FormatError(f"wrong column count: expected {first} {what} (as in the first data "
-                          f"row, line {int(linenos[0])}), found {int(counts[k])}: "
-                          f"{texts[k].strip()!r}", path, int(linenos[k]))
-    joined = " ".join(texts)
-    if sep is not None:
-        joined = joined.replace(sep, " ")
-    tokens = joined.split()
-    try:
-        if len(tokens) != n * first:
-            raise ValueError("empty field")
-        arr = np.array(tokens, dtype=float)
-    except ValueError:
-        for t, ln in zip(texts, linenos, strict=True):
-            for j, f in enumerate(split_fields(t, sep)):
-                if f == "":
-                    raise FormatError(f"empty field in column {j + 1}: {t.strip()!r}", path,
-                                      int(ln)) from None
-                if not _is_number(f):
-                    raise FormatError(f"non-numeric field {f!r} in column {j + 1}", path,
-                                      int(ln)) from None
-        raise  # pragma: no cover - the loop above always finds the culprit
-    return arr.reshape(n, first)
 
 
 def check_zenith_rows(values: np.ndarray, name: str, linenos, path, *, unit: str = "rad",
@@ -323,6 +234,8 @@ class AngleUnit(NamedTuple):
     #: where it came from: ``"option angles="``, ``"header ANGLE_UNITS"``, ``"VARS names"``,
     #: ``"default (radians)"``...
     source: str
+    #: whether the file itself declares the unit (a header key, units in the column names)
+    declared: bool = False
 
     @property
     def factor(self) -> float:
@@ -416,7 +329,61 @@ def resolve_angle_unit(option: str | None, claims: Sequence[UnitClaim], path, *,
         raise FormatError(f"angles={wanted!r} (CLI: --angles-in {wanted}) contradicts "
                           f"{first.text}{_where(first.line)}, which says {unit}", path,
                           first.line)
-    return AngleUnit(unit, first.source)
+    return AngleUnit(unit, first.source, declared=True)
+
+
+#: read as degrees, a file whose every zenith angle is below this (deg) looks like radians
+RADIAN_LIKE_DEG = 2.0
+#: read as radians, a file with an angle above this (rad) looks like degrees
+DEGREE_LIKE_RAD = 2 * math.pi + 1e-6
+
+
+def warn_implausible_angles(unit: AngleUnit, path, zeniths: Sequence[np.ndarray],
+                            azimuths: Sequence[np.ndarray] = (), *,
+                            names: str = "theta_i and theta_r", fixed: str = "") -> None:
+    """Warn (:class:`ImplausibleAnglesWarning`) when a file's angles, as written in it (in
+    ``unit``), look like the other unit; also when the file declares ``unit`` itself (the
+    numbers are implausible all the same).
+
+    Parameters
+    ----------
+    unit : AngleUnit
+        The unit the angles were read in (:func:`resolve_angle_unit`).
+    path
+        The file, for the message.
+    zeniths, azimuths : sequence of arrays
+        The angle columns as written in the file (finite: checked before). Read as degrees,
+        the warning needs every zenith below :data:`RADIAN_LIKE_DEG` (and one above 0: zeros
+        are the same in both units); read as radians, any zenith or azimuth above
+        :data:`DEGREE_LIKE_RAD`.
+    names : str
+        The zenith columns, as the message calls them.
+    fixed : str
+        For a format whose unit is fixed by its definition (ALTA): the advice of the message.
+    """
+    z = [np.abs(np.asarray(a, dtype=float)) for a in zeniths if np.size(a)]
+    if unit.word == "deg":
+        top = max((float(a.max()) for a in z), default=0.0)
+        if not 0.0 < top < RADIAN_LIKE_DEG:
+            return
+        other, seen = "rad", f"every {names} is below {RADIAN_LIKE_DEG:g} deg (the largest is " \
+            f"{top:.6g})"
+        looks = "radians"
+    else:
+        a = [*z, *(np.abs(np.asarray(v, dtype=float)) for v in azimuths if np.size(v))]
+        top = max((float(v.max()) for v in a), default=0.0)
+        if not top > DEGREE_LIKE_RAD:
+            return
+        other, seen, looks = "deg", f"an angle is {top:.6g}, above 2 pi", "degrees"
+    if fixed:
+        advice = fixed
+    elif unit.declared:
+        advice = "if they are, correct the file's declaration"
+    else:
+        advice = f"if they are, read the file with angles={other!r}"
+    warnings.warn(f"{path}: {seen}, with the angles read in {unit.word} ({unit.source}): they "
+                  f"look like {looks}; {advice}", ImplausibleAnglesWarning,
+                  stacklevel=outside_stacklevel())
 
 
 def check_fixed_units(fmt: str, angles: str | None, quantity: object, path,
@@ -588,7 +555,7 @@ def warn_not_written(path: Path, target: str, items: Sequence[str]) -> None:
     """One :class:`LossyWriteWarning` naming everything the ``target`` file cannot hold."""
     if items:
         warnings.warn(f"{path}: the {target} format has no place for {'; '.join(items)} - not "
-                      "written", LossyWriteWarning, stacklevel=_outside_stacklevel())
+                      "written", LossyWriteWarning, stacklevel=outside_stacklevel())
 
 
 def describe_keys(keys: Sequence[str], source: str) -> str:

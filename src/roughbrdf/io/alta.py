@@ -68,19 +68,19 @@ from ._common import (
     QuantityClaim,
     add_key,
     azimuth_rows,
-    begin_read,
     check_fixed_units,
     check_zenith_rows,
     common_frame_from_spherical,
     describe_keys,
     header_not_written,
-    parse_rows,
     prepare_target,
     resolve_angle_unit,
     resolve_quantity,
+    warn_implausible_angles,
     warn_not_written,
     write_table,
 )
+from ._rows import begin_read, parse_rows
 
 __all__ = ["read", "write", "EXTENSIONS", "PARAM_IN", "KEYS", "header_field"]
 
@@ -191,7 +191,9 @@ def _whole_number(header: _Header, key: str, path: Path) -> int:
     """``#key``'s value as a whole number >= 0 (else an error naming its line)."""
     text = header.keys[key]
     try:
-        n = int(text.split()[0])
+        tok = text.split()[0]
+        # int() would read '1_5' as 15 and full-width digits as digits: plain ASCII only
+        n = int(tok) if tok.isascii() and "_" not in tok else -1
     except (ValueError, IndexError):
         n = -1
     if n < 0:
@@ -393,6 +395,8 @@ def read(path: str | os.PathLike, *, quantity: str | None = None, angles: str | 
     x, values, uncertainty = _read_rows(header, layout, len(lines), path)
     theta_i, theta_r, phi = _GEOMETRY[layout.param_in](x, np.asarray(header.linenos), path,
                                                       unit.word)
+    warn_implausible_angles(unit, path, (), list(x.T), fixed="ALTA angles are radians by "
+                            "definition: check how the file was written")
     return Measurement(theta_i=theta_i, theta_r=theta_r, phi=phi, values=values,
                        channels=_read_channels(header, layout.nout, path), quantity=q,
                        uncertainty=uncertainty,

@@ -61,19 +61,26 @@ from ._common import (
     UnitClaim,
     add_key,
     azimuth_rows,
-    begin_read,
     check_zenith_rows,
     common_frame_from_spherical,
-    data_lines,
     describe_keys,
     header_not_written,
-    parse_rows,
     prepare_target,
     resolve_angle_unit,
     resolve_quantity,
     unit_word,
+    warn_implausible_angles,
     warn_not_written,
     write_table,
+)
+from ._rows import (
+    begin_read,
+    check_row_count,
+    count_fields,
+    parse_rows,
+    row_separator,
+    rows_from,
+    whole_number,
 )
 
 __all__ = ["read", "write", "EXTENSIONS", "header_field"]
@@ -242,30 +249,14 @@ def _read_units(header: _Header, angles: str | None, path: Path
     return names, unit
 
 
-def _read_num_points(header: _Header, path: Path) -> int | None:
-    """The ``NUM_POINTS`` keyword, if any (a number, else an error naming its line)."""
-    if "NUM_POINTS" not in header.keys:
-        return None
-    text = header.keys["NUM_POINTS"]
-    try:
-        n = float(text.split()[0])
-    except (ValueError, IndexError):
-        n = math.nan
-    if not (math.isfinite(n) and n >= 0 and n.is_integer()):
-        raise FormatError(f"NUM_POINTS must be a whole number of rows, got {text!r}", path,
-                          header.line("NUM_POINTS"))
-    return int(n)
-
-
 def _read_columns(names: list[str], first_row: str, header: _Header) -> _Columns:
     """Columns phase: canonical angle names; when the rows have one value more than VARS has
     names and VARS has ``theta_s`` but no ``phi_s`` (the Mini-Diff files), ``phi_s`` is inserted
     after ``theta_s`` (recorded as a quirk)."""
     names = list(names)
     canon = [_ANGLE_NAMES.get(n.lower()) for n in names]
-    sep = "," if "," in first_row else None
-    ncols_first = (first_row.count(",") + 1) if sep else len(first_row.split())
-    if ncols_first == len(names) + 1 and "phi_s" not in canon and "theta_s" in canon:
+    if count_fields(first_row, row_separator(first_row)) == len(names) + 1 and \
+            "phi_s" not in canon and "theta_s" in canon:
         k = canon.index("theta_s") + 1
         names.insert(k, "phi_s")
         canon.insert(k, "phi_s")
@@ -285,28 +276,13 @@ def _check_roles(cols: _Columns, header: _Header, path: Path) -> None:
                           header.line("VARS"))
 
 
-def _read_rows(lines: list[str], header: _Header, declared_n: int | None, path: Path
-               ) -> tuple[list[str], list[int]]:
-    """Rows phase: the non-blank lines from the first data row on, with their line numbers."""
-    if header.data_start is None:
-        raise FormatError(f"no data rows (NUM_POINTS {declared_n})", path, len(lines) + 1)
-    return data_lines(lines, header.data_start)
-
-
 def _parse_rows(texts: list[str], linenos: list[int], cols: _Columns, declared_n: int | None,
                 n_lines: int, path: Path) -> np.ndarray:
     """Rows phase: the numbers (comma or blank separated, one value per column) and their count
     against ``NUM_POINTS``."""
-    sep = "," if "," in texts[0] else None
-    data = parse_rows(texts, linenos, len(cols.names), path, sep=sep,
+    data = parse_rows(texts, linenos, len(cols.names), path, sep=row_separator(texts[0]),
                       what=f"values (VARS: {', '.join(cols.names)})")
-    if declared_n is not None and data.shape[0] != declared_n:
-        if data.shape[0] < declared_n:
-            raise FormatError(f"truncated file: NUM_POINTS is {declared_n} but only "
-                              f"{data.shape[0]} data rows follow (file ends at line "
-                              f"{n_lines})", path, n_lines + 1)
-        raise FormatError(f"{data.shape[0]} data rows but NUM_POINTS is {declared_n}; first "
-                          "extra row here", path, linenos[declared_n])
+    check_row_count(data.shape[0], declared_n, "NUM_POINTS", linenos, n_lines, path)
     return data
 
 
@@ -328,6 +304,8 @@ def _read_angles(data: np.ndarray, cols: _Columns, unit: AngleUnit, ln: np.ndarr
         raise FormatError(f"VARS has no phi_s column and the rows have no extra value: "
                           f"{cols.names}", path, header.line("VARS"))
     out["phi_s"] = azimuth_rows(col["phi_s"], "phi_s", ln, path) * unit.factor
+    warn_implausible_angles(unit, path, [col["theta_i"], col["theta_s"]], list(col.values()),
+                            names="theta_i and theta_s")
     beyond = (np.abs(out["phi_i"]) > _TWO_PI_SLACK) | (np.abs(out["phi_s"]) > _TWO_PI_SLACK)
     if unit.word == "rad" and beyond.any():
         raise FormatError("azimuth beyond 2 pi rad: the angles look like degrees; declare the "
@@ -446,8 +424,10 @@ def read(path: str | os.PathLike, *, angles: str | None = None, quantity: str | 
     path, lines = begin_read("astm", path, options, quantity)
     header = _read_header(lines, path)
     names, unit = _read_units(header, angles, path)
-    declared_n = _read_num_points(header, path)
-    texts, linenos = _read_rows(lines, header, declared_n, path)
+    declared_n = whole_number(header.keys.get("NUM_POINTS"), "NUM_POINTS", path,
+                              header.line("NUM_POINTS"))
+    texts, linenos = rows_from(lines, header.data_start, path,
+                               f"no data rows (NUM_POINTS {declared_n})")
     cols = _read_columns(names, texts[0], header)
     data = _parse_rows(texts, linenos, cols, declared_n, len(lines), path)
     _check_roles(cols, header, path)

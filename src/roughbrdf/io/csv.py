@@ -80,16 +80,16 @@ from ._common import (
     UnitClaim,
     add_key,
     azimuth_rows,
-    begin_read,
     check_zenith_rows,
     data_lines,
-    parse_rows,
     prepare_target,
     resolve_angle_unit,
     resolve_quantity,
     unit_word,
+    warn_implausible_angles,
     write_table,
 )
+from ._rows import begin_read, parse_number, parse_rows
 
 __all__ = ["read", "write", "EXTENSIONS", "TAG", "header_field"]
 
@@ -333,7 +333,7 @@ def _read_polarization(texts: list[str], linenos: list[int], cols: _Columns, pol
         tok = r[pol_col].strip()
         if tok not in cache:
             try:
-                cache[tok] = float(tok) * unit.factor if tok else math.nan
+                cache[tok] = parse_number(tok) * unit.factor if tok else math.nan
             except ValueError:
                 try:
                     cache[tok] = polarization_angle(tok)
@@ -362,12 +362,16 @@ def _read_rows(lines: list[str], header: _Header, cols: _Columns, roles: _Roles,
                       what=f"values ({', '.join(cols.names)})")
     ln = np.asarray(linenos)
     col = {a: data[:, j] for a, j in roles.angles.items()}
-    return {
+    angles = {
         "theta_i": check_zenith_rows(col["theta_i"] * unit.factor, "theta_i", ln, path,
                                      unit=unit.word),
         "theta_r": check_zenith_rows(col["theta_r"] * unit.factor, "theta_r", ln, path,
                                      unit=unit.word),
         "phi": azimuth_rows(col["phi"], "phi", ln, path) * unit.factor,
+    }
+    warn_implausible_angles(unit, path, [col["theta_i"], col["theta_r"]], [col["phi"]])
+    return {
+        **angles,
         "values": data[:, roles.channel_cols],
         "polarization": polarization,
         "uncertainty": (data[:, [roles.sigma_cols[c] for c in roles.channels]]

@@ -108,14 +108,13 @@ from ..quantity import Quantity
 from ._common import (
     LAYOUT,
     FormatError,
-    begin_read,
     describe_keys,
     header_not_written,
-    parse_rows,
     prepare_target,
     unit_word,
     warn_not_written,
 )
+from ._rows import begin_read, parse_rows
 
 __all__ = ["read", "write", "read_table", "write_table", "table_integral", "plan",
            "specular_to_common", "common_to_specular", "grid_from_radians",

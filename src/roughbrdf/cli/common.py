@@ -26,6 +26,52 @@ from . import EXIT_BUG, EXIT_INTERRUPTED, EXIT_OS, EXIT_USAGE, _Run
 if TYPE_CHECKING:
     import numpy as np
 
+    from ..errors import ArgumentError
+    from ..measurement import Measurement
+    from ..models import Model
+
+#: the options of each verb: ``{Python argument name: CLI option}``, one table per verb. Errors
+#: of the library name Python arguments (:class:`~roughbrdf.errors.ArgumentError`, and messages
+#: of the readers such as ``pass angles=``); :func:`handled` words them with the table of the
+#: verb that was run, so that a message names an option of that verb (``fit`` has
+#: ``--format``, ``convert`` has ``--from/--to``).
+EVAL_OPTIONS = {"theta_i": "--theta-i", "theta_r": "--theta-r", "phi": "--phi",
+                "polarization": "--polarization", "gamma": "--polarization",
+                "quantity": "--quantity"}
+FIT_OPTIONS = {"model": "--model", "fix": "--fix", "bounds": "--bounds", "channel": "--channel",
+               "loss": "--loss", "starts": "--starts", "quantity": "--quantity",
+               "relative_to": "--relative-to", "format": "--format", "angles": "--angles-in",
+               "nonfinite": "--nonfinite", "negative": "--negative", "seed": "--seed",
+               "free_scale": "--free-scale", "aperture": "--aperture", "out_dir": "--out",
+               "theta_r_max": "--theta-r-max", "source_exclusion": "--source-exclusion",
+               "overwrite": "--force", "plots": "--plots/--no-plots", "joint": "--joint",
+               "shared": "--shared", "extrapolated": "--keep-extrapolated",
+               "candidates": "--models", "cv": "--cv/--no-cv"}
+COMPARE_OPTIONS = {"candidates": "--models", "models": "--models", "cv": "--cv/--no-cv",
+                   "channel": "--channel", "loss": "--loss", "starts": "--starts",
+                   "joint": "--joint", "quantity": "--quantity", "angles": "--angles-in",
+                   "format": "--format", "aperture": "--aperture",
+                   "theta_r_max": "--theta-r-max", "source_exclusion": "--source-exclusion",
+                   "extrapolated": "--keep-extrapolated", "negative": "--negative",
+                   "seed": "--seed", "plots": "--plots/--no-plots", "overwrite": "--force",
+                   "out_dir": "--out"}
+PLOT_OPTIONS = {"theta_i": "--theta-i", "elevation": "--elevation", "quantity": "--quantity",
+                "kind": "--kind", "log": "--log/--linear", "channel": "--channel",
+                "overwrite": "--force", "path": "--out"}
+EXPORT_OPTIONS = {"to": "--to", "channel": "--channel", "overwrite": "--force",
+                  "fit": "--fit-closest", "angles_of_incidence": "--incidences",
+                  "radial": "--radial", "azimuth": "--azimuth", "symmetry": "--symmetry",
+                  "rgb": "--rgb/--no-rgb", "theta_max": "--theta-max", "out": "--out"}
+CONVERT_OPTIONS = {"quantity": "--quantity", "angles": "--angles-in", "stride": "--stride",
+                   "overwrite": "--force", "resample": "--resample", "path": "OUT",
+                   "channel": "--channel", "format": "--from/--to"}
+REPRODUCE_OPTIONS = {"paper": "--paper", "out": "--out", "overwrite": "--force",
+                     "data_dir": "--data"}
+
+#: the largest number of values one range option (``START:STOP:STEP``) may give: a typo such
+#: as ``0:90:1e-7`` would otherwise take the memory of the machine
+MAX_RANGE_POINTS = 100_000
+
 #: exceptions Typer shows by itself (usage errors, exits)
 _TYPER_OWN: tuple[type[BaseException], ...] = (
     typer.Exit, typer.Abort,
@@ -108,8 +154,11 @@ def error_message(exc: BaseException, options: Mapping[str, str] | None = None,
     from ..errors import ArgumentError
     from ..output import OverwriteRefused
 
-    if isinstance(exc, ArgumentError | OverwriteRefused):
-        return exc.render({"overwrite": "--force", **(options or {})})
+    opts = {"overwrite": "--force", **(options or {})}
+    if isinstance(exc, ArgumentError):
+        return cli_text(argument_text(exc, opts), opts)
+    if isinstance(exc, OverwriteRefused):
+        return exc.render(opts)
     if isinstance(exc, OSError) and exc.strerror:
         where = exc.filename
         if exc.filename2 is not None:
@@ -121,6 +170,67 @@ def error_message(exc: BaseException, options: Mapping[str, str] | None = None,
     if (exit_status(exc) if code is None else code) == EXIT_BUG:
         return (f"internal error: {type(exc).__name__}: {text} (a bug in roughbrdf; "
                 f"`roughbrdf --debug ...` shows the traceback)")
+    return cli_text(text, opts)
+
+
+def argument_text(exc: ArgumentError, options: Mapping[str, str]) -> str:
+    """``exc`` rendered with the verb's ``options``, always naming the option.
+
+    A check worded in Python terms without the value (``"starts must be >= 1"``) names the
+    option in place of the argument (``"--starts must be >= 1"``), or ahead of the message.
+
+    Examples
+    --------
+    >>> from roughbrdf.errors import ArgumentError
+    >>> argument_text(ArgumentError("starts", "starts must be >= 1, got 0"), {"starts": "--starts"})
+    '--starts must be >= 1, got 0'
+    >>> argument_text(ArgumentError("loss", "unknown loss 'x'"), {"loss": "--loss"})
+    "--loss: unknown loss 'x'"
+    """
+    text = " ".join(exc.render(options).split())
+    opt = options.get(exc.argument)
+    if opt is None or opt in text:  # not an option of this verb, or already named
+        return text
+    for sep in (" ", ":"):
+        if text.startswith(exc.argument + sep):
+            return opt + text[len(exc.argument):]
+    return f"{opt}: {text}"
+
+
+#: a value after ``name=`` in a library message: quoted, or a bare word
+_HINT_VALUE = r"(?:'[^']*'|\"[^\"]*\"|[\w.+-]+)"
+
+
+def cli_text(text: str, options: Mapping[str, str] | None) -> str:
+    """A library message with its Python argument hints worded as this verb's options.
+
+    The readers and the fit speak Python (``pass format=``, ``angles='deg'``), sometimes with a
+    CLI hint for one verb (``(CLI: --from/--to)``); each ``name=`` of an argument in
+    ``options`` becomes that option, hint included.
+
+    Examples
+    --------
+    >>> cli_text("unknown extension; pass format= (CLI: --from/--to)", FIT_OPTIONS)
+    'unknown extension; pass --format'
+    >>> cli_text("the angles look like degrees (angles='deg'; CLI: --angles-in deg)",
+    ...          FIT_OPTIONS)
+    'the angles look like degrees (--angles-in deg)'
+    >>> cli_text("exists (pass overwrite=True; CLI: --force)", CONVERT_OPTIONS)
+    'exists (pass --force)'
+    """
+    import re
+
+    for arg, opt in (options or {}).items():
+        if not arg.isidentifier() or f"{arg}=" not in text:  # fast path: nothing to word
+            continue
+        pattern = (rf"\b{re.escape(arg)}=({_HINT_VALUE})?"
+                   r"(?:;\s*CLI:\s*[^);]*|\s*\((?:CLI:\s*)?--[^)]*\))?")
+
+        def word(m: re.Match[str], opt: str = opt) -> str:
+            value = (m.group(1) or "").strip("'\"")
+            return opt if value in ("", "True") else f"{opt} {value}"
+
+        text = re.sub(pattern, word, text)
     return text
 
 
@@ -128,8 +238,8 @@ def parse_params(items: list[str] | None) -> dict[str, float | None | str]:
     """``["e=0.5", "n=None", "distribution=ggx"]`` -> dict (numbers where they parse)."""
     out: dict[str, float | None | str] = {}
     for item in items or []:
-        if "=" not in item:
-            raise typer.BadParameter(f"expected name=value, got {item!r}")
+        if "=" not in item:  # a ValueError, not Typer's: one line inside handled()
+            raise ValueError(f"-p/--param: expected name=value, got {item!r}")
         key, val = item.split("=", 1)
         key, val = key.strip(), val.strip()
         if val.lower() == "none":
@@ -143,19 +253,135 @@ def parse_params(items: list[str] | None) -> dict[str, float | None | str]:
 
 
 def degree_range(text: str, name: str) -> np.ndarray:
-    """``"30"`` or ``"0:90:5"`` (start:stop:step, stop inclusive) in degrees -> radians."""
+    """``"30"`` or ``"0:90:5"`` (start:stop:step, stop inclusive) in degrees -> radians.
+
+    Raises ``ValueError`` naming the option ``name`` and the text for anything but finite
+    numbers, a zero step, a step that never reaches STOP (an empty range) and a range of more
+    than :data:`MAX_RANGE_POINTS` values.
+
+    Examples
+    --------
+    >>> [round(float(x), 4) for x in degree_range("90:0:-45", "--theta-r")]
+    [1.5708, 0.7854, 0.0]
+    >>> degree_range("0:inf:1", "--theta-r")
+    Traceback (most recent call last):
+    ...
+    ValueError: --theta-r '0:inf:1': START, STOP and STEP must be finite numbers of degrees
+    """
     import numpy as np
 
     try:
         parts = [float(x) for x in text.split(":")]
-    except ValueError as exc:
-        raise typer.BadParameter(f"{name}: expected DEG or START:STOP:STEP, got {text!r}") from exc
+    except ValueError:
+        raise ValueError(f"{name} {text!r}: expected DEG or START:STOP:STEP (degrees)") from None
+    if len(parts) not in (1, 3):
+        raise ValueError(f"{name} {text!r}: expected DEG or START:STOP:STEP (degrees)")
+    if not all(math.isfinite(x) for x in parts):  # nan/inf: no angle, no count of points
+        what = "DEG must be a finite number" if len(parts) == 1 else \
+            "START, STOP and STEP must be finite numbers"
+        raise ValueError(f"{name} {text!r}: {what} of degrees")
     if len(parts) == 1:
         return np.radians(np.array(parts))
-    if len(parts) != 3 or parts[2] == 0:
-        raise typer.BadParameter(f"{name}: expected START:STOP:STEP with STEP != 0, got {text!r}")
     start, stop, step = parts
-    n = int(math.floor((stop - start) / step + 1e-9)) + 1
-    if n <= 0:
-        raise typer.BadParameter(f"{name}: empty range {text!r}")
-    return np.radians(start + step * np.arange(n))
+    if step == 0:  # would never reach STOP
+        raise ValueError(f"{name} {text!r}: STEP must not be 0")
+    count = math.floor((stop - start) / step + 1e-9) + 1
+    if count <= 0:  # the step goes away from STOP
+        raise ValueError(f"{name} {text!r}: empty range (STEP {step:g} goes away from STOP; "
+                         f"use a {'negative' if stop < start else 'positive'} STEP)")
+    if count > MAX_RANGE_POINTS:  # a typo of STEP must not exhaust the memory
+        raise ValueError(f"{name} {text!r}: {count:.4g} values, more than the limit of "
+                         f"{MAX_RANGE_POINTS} per range; use a larger STEP")
+    return np.radians(start + step * np.arange(count))
+
+
+# --------------------------------------------------------------------------------------------
+# model parameters whose unit is an angle: degrees at the CLI, radians in the library
+# --------------------------------------------------------------------------------------------
+#: the unit of a model parameter (:attr:`roughbrdf.models.Parameter.unit`) that is an angle;
+#: the CLI takes and prints such parameters in degrees. Units *per* angle (TS67 ``c`` in
+#: ``1/deg``, RB08's ``1/rad`` coefficients) are rates, not angles: they are left as they are.
+ANGLE_UNIT = "rad"
+
+
+def cli_unit(unit: str) -> str:
+    """The unit a CLI shows for a parameter of ``unit`` (``"rad"`` -> ``"deg"``)."""
+    return "deg" if unit == ANGLE_UNIT else unit
+
+
+def cli_number(unit: str, value: float | None) -> float | None:
+    """``value`` of a parameter of ``unit`` as the CLI shows it (radians -> degrees)."""
+    if value is None or unit != ANGLE_UNIT:
+        return value
+    return math.degrees(value)
+
+
+def angle_names(model: Model) -> set[str]:
+    """The parameters of ``model`` (prefixed in sums) whose unit is an angle."""
+    return {p.name for p in model.parameters if p.unit == ANGLE_UNIT}
+
+
+def cli_model(spec: str, params: Mapping[str, object] | None = None) -> Model:
+    """``roughbrdf.model(spec, **params)`` with ``-p`` settings as the CLI gives them: a
+    parameter whose unit is an angle (Oren-Nayar ``sigma``, also in ``coated(diffuse=
+    "oren-nayar")`` and in sums, by plain or prefixed name) in degrees.
+
+    Examples
+    --------
+    >>> round(cli_model("oren-nayar", {"sigma": 20.0}).params["sigma"], 6)
+    0.349066
+    """
+    from .. import models as _models
+
+    given = dict(params or {})
+    first = _models.model(spec, **given)  # names and units (angles in degrees pass the
+    angles = angle_names(first)  # sign checks of their domains just as well)
+    if not angles:
+        return first
+    converted = dict(given)
+    for key, value in given.items():
+        if not isinstance(value, float):
+            continue
+        try:
+            (name,) = _models.resolve_names(first, [key])
+        except ValueError:  # an option (diffuse=...), not a parameter
+            continue
+        if name in angles:
+            converted[key] = math.radians(value)
+    return _models.model(spec, **converted)
+
+
+def cli_parameter_lines(model: Model) -> list[str]:
+    """The parameter lines of :meth:`Model.describe <roughbrdf.models.Model.describe>` as the
+    CLI shows them: angles in degrees, ``[deg]``."""
+    lines = []
+    for p in model.parameters:
+        value = cli_number(p.unit, p.value)
+        shown = f"{value:.6g}" if isinstance(value, float) and p.unit == ANGLE_UNIT else value
+        lines.append(f"  {p.name:<10} = {shown!s:<12} [{cli_unit(p.unit)}]  {p.description}")
+    return lines
+
+
+def check_channels(meas: Measurement, channels: list[str] | None) -> list[int]:
+    """The positions of ``--channel`` labels (or indices) in ``meas``; an unknown one is refused
+    naming it and listing the channels of the file.
+
+    Examples
+    --------
+    >>> from roughbrdf.measurement import Measurement
+    >>> m = Measurement([0.1], [0.2], [0.0], [[1.0, 2.0]], channels=["465nm", "525nm"])
+    >>> check_channels(m, ["525"])
+    [1]
+    >>> check_channels(m, ["550"])
+    Traceback (most recent call last):
+    ...
+    ValueError: --channel: unknown channel '550' (channels: 465nm, 525nm)
+    """
+    out = []
+    for c in channels or []:
+        try:
+            out.append(meas.channel_index(c))
+        except (ValueError, TypeError):  # the measurement's own words do not list them all
+            raise ValueError(f"--channel: unknown channel {c!r} (channels: "
+                             f"{', '.join(meas.channels)})") from None
+    return out

@@ -14,8 +14,7 @@ from typing import Any
 
 import typer
 
-from .common import handled
-from .fit import OPTIONS as FIT_OPTIONS
+from .common import COMPARE_OPTIONS, check_channels, handled
 from .fit import (
     AnglesInOption,
     ApertureOption,
@@ -36,7 +35,8 @@ from .fit import (
     read_input,
 )
 
-OPTIONS = {**FIT_OPTIONS, "candidates": "--models", "cv": "--cv/--no-cv"}
+#: the library's argument names -> this verb's options (errors name the options)
+OPTIONS = COMPARE_OPTIONS
 
 #: the files of ``--out``
 FILES = ("compare.md", "compare.json", "compare.png")
@@ -56,6 +56,7 @@ def run_compare(file: str, models: str | None, out: str | None, *, force: bool,
     ap = check_aperture(aperture)
     t_max, excl = fit_domain(theta_r_max, source_exclusion)
     meas = read_input(file, file_format, quantity, angles_in)
+    check_channels(meas, channel)  # an unknown label listed with the file's channels
     names = [n for n in FILES if plots or not n.endswith(".png")]
     if out is not None:
         ResultFolder(out, overwrite=force).check(names)

@@ -15,15 +15,15 @@ from typing import Annotated, Any
 
 import typer
 
+from .common import CONVERT_OPTIONS, cli_text
+
 #: the quantities a measurement can hold, for the help text (the same as
 #: :data:`roughbrdf.measurement.QUANTITIES`, written out so that ``--help`` imports no NumPy/Numba;
 #: the command itself checks against the library's tuple)
 HELP_QUANTITIES = ("brdf", "brdf_cos", "bridf", "relative")
 
 #: library argument -> the option of this command that sets it (for ArgumentError messages)
-OPTIONS = {"quantity": "--quantity", "angles": "--angles-in", "stride": "--stride",
-           "overwrite": "--force", "resample": "--resample", "path": "OUT",
-           "channel": "--channel"}
+OPTIONS = CONVERT_OPTIONS
 #: arguments set by a flag: "pass resample=True" is "pass --resample"
 FLAGS = {"overwrite": "--force", "resample": "--resample"}
 
@@ -44,8 +44,8 @@ def _cli_message(exc: BaseException) -> str:
     if isinstance(exc, ArgumentError):
         if exc.argument in FLAGS and exc.fix is True:
             return f"{exc.message}; pass {FLAGS[exc.argument]} to do it anyway"
-        return exc.render(OPTIONS)
-    return str(exc)
+        return cli_text(exc.render(OPTIONS), OPTIONS)
+    return cli_text(str(exc), OPTIONS)  # the readers' Python hints (format=) as options
 
 
 def _os_message(exc: OSError, src: Path, dst: Path) -> str:

@@ -7,11 +7,25 @@ from typing import Annotated
 
 import typer
 
-from .common import degree_range, handled, parse_params
+from .common import (
+    EVAL_OPTIONS,
+    MAX_RANGE_POINTS,
+    cli_model,
+    cli_parameter_lines,
+    degree_range,
+    handled,
+    parse_params,
+)
 
 #: the library's argument names -> this verb's options (errors name the options)
-OPTIONS = {"theta_i": "--theta-i", "theta_r": "--theta-r", "phi": "--phi",
-           "polarization": "--polarization", "gamma": "--polarization", "quantity": "--quantity"}
+OPTIONS = EVAL_OPTIONS
+
+#: the polarization names ``--polarization`` takes (else an angle gamma in degrees)
+POLARIZATION_NAMES = ("unpolarized", "s", "p")
+
+#: the largest grid ``roughbrdf eval`` prints (theta_i x theta_r x phi values): each is a
+#: line of CSV
+MAX_EVAL_POINTS = 10 * MAX_RANGE_POINTS
 
 
 def describe_with_aliases(name: str) -> str:
@@ -19,11 +33,36 @@ def describe_with_aliases(name: str) -> str:
     from .. import models as _models
 
     m = _models.model(name)
-    lines = m.describe().splitlines()
+    lines = [m.describe().splitlines()[0]]
     aliases = tuple(getattr(type(m), "aliases", ()))
     if aliases:
-        lines.insert(1, f"  aliases: {', '.join(aliases)}")
-    return "\n".join(lines)
+        lines.append(f"  aliases: {', '.join(aliases)}")
+    lines += [f"  option {k} = {v!r}" for k, v in m.options.items()]
+    return "\n".join(lines + cli_parameter_lines(m))  # angles in degrees, as -p takes them
+
+
+def polarization_value(text: str) -> object:
+    """``--polarization`` -> the library's value: a name, or gamma (degrees) in radians.
+
+    Examples
+    --------
+    >>> polarization_value("S"), round(float(polarization_value("90")), 4)
+    ('s', 1.5708)
+    """
+    import math
+
+    name = text.strip().lower()
+    if name in POLARIZATION_NAMES:
+        return name
+    try:
+        gamma = float(name)
+    except ValueError:
+        raise ValueError(f"--polarization {text!r}: expected unpolarized, s, p or an angle "
+                         f"gamma in degrees from the plane of incidence") from None
+    if not math.isfinite(gamma):  # no direction of the field
+        raise ValueError(f"--polarization {text!r}: the angle gamma must be a finite number "
+                         f"of degrees")
+    return math.radians(gamma)
 
 
 def register(app: typer.Typer) -> None:
@@ -49,7 +88,8 @@ def register(app: typer.Typer) -> None:
         phi: Annotated[str, typer.Option(
             "--phi", help="azimuth (0 = forward), DEG or START:STOP:STEP")] = "0",
         polarization: Annotated[str, typer.Option(
-            help="unpolarized, s, p or gamma in DEG")] = "unpolarized",
+            help="unpolarized, s, p or the angle gamma of the field from the plane of "
+                 "incidence in DEG")] = "unpolarized",
         quantity: Annotated[str, typer.Option(
             help="output: the quantity printed, brdf, brdf_cos (= bridf), bridf or relative "
                  "(to the specular value)")] = "brdf",
@@ -64,17 +104,17 @@ def _evaluate(model: str, params: dict, theta_i: str, theta_r: str, phi: str,
     """The work of ``roughbrdf eval``: the CSV table on stdout."""
     import numpy as np
 
-    from .. import models as _models
     from ..quantity import Quantity
 
-    m = _models.model(model, **params)
+    m = cli_model(model, params)  # -p angles (Oren-Nayar sigma) in degrees
     ti = degree_range(theta_i, "--theta-i")
     tr = degree_range(theta_r, "--theta-r")
     ph = degree_range(phi, "--phi")
-    try:
-        pol: object = np.radians(float(polarization))
-    except ValueError:
-        pol = polarization
+    if ti.size * tr.size * ph.size > MAX_EVAL_POINTS:  # one CSV line each
+        raise ValueError(f"--theta-i x --theta-r x --phi: {ti.size} x {tr.size} x {ph.size} "
+                         f"= {ti.size * tr.size * ph.size} points, more than the limit of "
+                         f"{MAX_EVAL_POINTS}; use larger steps")
+    pol = polarization_value(polarization)
     q = Quantity.parse(quantity, "--quantity")
     TI, TR, PH = (a.reshape(-1) for a in np.meshgrid(ti, tr, ph, indexing="ij"))
     f = m.evaluate(TI, TR, PH, quantity=q, polarization=pol)
@@ -82,4 +122,4 @@ def _evaluate(model: str, params: dict, theta_i: str, theta_r: str, phi: str,
     w.write(f"theta_i_deg,theta_r_deg,phi_deg,{quantity}\n")
     for a, b, c, v in zip(np.degrees(TI), np.degrees(TR), np.degrees(PH), np.atleast_1d(f),
                           strict=True):
-        w.write(f"{a:.6g},{b:.6g},{c:.6g},{v:.10g}\n")
+        w.write(f"{a:.6g},{b:.6g},{c:.6g},{v:.15g}\n")

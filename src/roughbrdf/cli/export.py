@@ -17,13 +17,10 @@ from typing import Annotated, Any
 
 import typer
 
-from .common import degree_range, handled, parse_params
+from .common import EXPORT_OPTIONS, cli_model, degree_range, handled, parse_params
 
 #: the library's argument names -> this verb's options (errors name the options)
-OPTIONS = {"to": "--to", "channel": "--channel", "overwrite": "--force", "fit": "--fit-closest",
-           "angles_of_incidence": "--incidences", "radial": "--radial",
-           "azimuth": "--azimuth", "symmetry": "--symmetry", "rgb": "--rgb/--no-rgb",
-           "theta_max": "--theta-max", "out": "--out"}
+OPTIONS = EXPORT_OPTIONS
 
 
 def _source(model: str | None, param: list[str] | None, fit_dir: str | None) -> Any:
@@ -36,9 +33,7 @@ def _source(model: str | None, param: list[str] | None, fit_dir: str | None) -> 
         from ..fitting.result import fitted_models
 
         return fitted_models(fit_dir)
-    from ..models import model as make_model
-
-    return make_model(str(model), **parse_params(param))
+    return cli_model(str(model), parse_params(param))  # -p angles (sigma) in degrees
 
 
 def _zemax_options(incidences: str | None, radial: str | None, azimuth: str | None,

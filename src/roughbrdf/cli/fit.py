@@ -35,22 +35,14 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from .common import handled, parse_params
+from .common import FIT_OPTIONS, angle_names, check_channels, cli_model, handled, parse_params
 
 if TYPE_CHECKING:
     from ..measurement import Measurement
     from ..models import Model
 
 #: the library's argument names -> this verb's options (errors name the options)
-OPTIONS = {"model": "--model", "fix": "--fix", "bounds": "--bounds", "channel": "--channel",
-           "loss": "--loss", "starts": "--starts", "quantity": "--quantity",
-           "relative_to": "--relative-to", "format": "--format", "angles": "--angles-in",
-           "nonfinite": "--nonfinite", "negative": "--negative", "seed": "--seed",
-           "free_scale": "--free-scale", "aperture": "--aperture", "out_dir": "--out",
-           "theta_r_max": "--theta-r-max", "source_exclusion": "--source-exclusion",
-           "overwrite": "--force", "plots": "--plots/--no-plots", "joint": "--joint",
-           "shared": "--shared", "extrapolated": "--keep-extrapolated",
-           "candidates": "--models", "cv": "--cv/--no-cv"}
+OPTIONS = FIT_OPTIONS
 
 #: spellings of --angles-in -> the readers' angles= option
 ANGLE_UNITS = {"deg": "deg", "degree": "deg", "degrees": "deg", "rad": "rad", "radian": "rad",
@@ -119,10 +111,10 @@ PlotsOption = Annotated[bool, typer.Option("--plots/--no-plots", help="write PNG
 
 
 def build_model(spec: str, params: dict[str, Any] | None = None) -> Model:
-    """A model from ``name`` or ``name1+name2`` and ``-p`` settings (:func:`roughbrdf.model`)."""
-    from .. import models as _models
-
-    return _models.model(spec, **(params or {}))
+    """A model from ``name`` or ``name1+name2`` and ``-p`` settings (:func:`roughbrdf.model`);
+    a parameter whose unit is an angle (Oren-Nayar ``sigma``) is given in degrees
+    (:func:`~roughbrdf.cli.common.cli_model`)."""
+    return cli_model(spec, params)
 
 
 def resolve_names(model: Model, names: list[str]) -> list[str]:
@@ -135,7 +127,8 @@ def resolve_names(model: Model, names: list[str]) -> list[str]:
 def parse_bounds(model: Model, items: list[str] | None) -> dict[str, tuple[float, float]]:
     """``--bounds NAME=LOW:HIGH`` (repeatable) -> ``{parameter: (low, high)}`` for ``rb.fit``.
 
-    Names are resolved like ``--fix`` (plain names allowed in sums).
+    Names are resolved like ``--fix`` (plain names allowed in sums); the range of a parameter
+    whose unit is an angle (Oren-Nayar ``sigma``) is in degrees, like its ``-p`` value.
 
     Examples
     --------
@@ -157,7 +150,8 @@ def parse_bounds(model: Model, items: list[str] | None) -> dict[str, tuple[float
         if not (math.isfinite(low) and math.isfinite(high) and low < high):
             raise ValueError(f"--bounds {item}: need finite LOW < HIGH")
         (key,) = resolve_names(model, [name.strip()])
-        out[key] = (low, high)
+        out[key] = ((math.radians(low), math.radians(high)) if key in angle_names(model)
+                    else (low, high))
     return out
 
 
@@ -203,6 +197,9 @@ def read_input(file: str, file_format: str | None, quantity: str | None,
 
     if not Path(file).exists():
         raise FileNotFoundError(errno.ENOENT, "no such file", file)
+    if Path(file).is_dir():  # not a file of an unknown extension: a verb for one file
+        raise ValueError(f"{file} is a folder: this command reads one measurement file "
+                         f"(fit-batch fits the files of a folder)")
     opts: dict[str, Any] = {}
     if quantity:
         opts["quantity"] = Quantity.parse(quantity, "--quantity").value
@@ -223,7 +220,7 @@ def result_names(meas: Measurement, channel: list[str] | None, plots: bool,
     """The files the run will write (``FitResult.save``: ``fit.json``, ``report.txt``,
     ``fit_<channel>.png`` as :meth:`roughbrdf.FitResult.plot_names` names them, and
     ``compare.png`` for ``--model auto``)."""
-    labels = ([meas.channels[meas.channel_index(c)] for c in channel] if channel
+    labels = ([meas.channels[i] for i in check_channels(meas, channel)] if channel
               else list(meas.channels))
     if getattr(meas, "mueller", None):  # Mueller elements are fitted as one "channel"
         labels = ["mueller"]
@@ -308,9 +305,11 @@ def run_fit(file: str, model: str, out: str, *, param: list[str] | None,
         res = fit_auto(meas, models, cv=cv, **common)
     else:
         res = fit(m, meas, fix=fixed, bounds=ranges or None, **common)
-    written = res.save(out, plots=plots, overwrite=force)
+    # the report in degrees with the unit named, on the terminal and in report.txt (fit.json
+    # keeps the library's radians)
+    written = res.save(out, plots=plots, overwrite=force, report_angles="deg")
     if not quiet:
-        typer.echo(res.report())
+        typer.echo(res.report(angles="deg"))
         typer.echo("")
     typer.echo("wrote " + ", ".join(str(p) for p in written))
     return 0 if res.success else 1

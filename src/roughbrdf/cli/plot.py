@@ -19,14 +19,12 @@ from typing import Annotated, Any
 
 import typer
 
-from .common import degree_range, handled, parse_params
+from .common import PLOT_OPTIONS, cli_model, degree_range, handled, parse_params
 
 KINDS = ("in-plane", "polar", "hemisphere", "mueller", "mueller-plane", "dolp")
 
 #: the library's argument names -> this verb's options (errors name the options)
-OPTIONS = {"theta_i": "--theta-i", "elevation": "--elevation", "quantity": "--quantity",
-           "kind": "--kind", "log": "--log/--linear", "channel": "--channel",
-           "overwrite": "--force", "path": "--out"}
+OPTIONS = PLOT_OPTIONS
 
 
 def _check_out(path: Path, force: bool) -> None:
@@ -58,10 +56,9 @@ def _model_figure(model_name: str, params: dict[str, Any], kind: str, theta_i: s
                   elevation: float, quantity: str, log: bool | None):
     import numpy as np
 
-    from .. import models as _models
     from .. import plot as rbplot
 
-    m = _models.model(model_name, **params)
+    m = cli_model(model_name, params)  # -p angles (Oren-Nayar sigma) in degrees
     ti = degree_range(theta_i, "--theta-i")
     if kind in ("mueller", "mueller-plane", "dolp"):
         return _polarimetric_figure(m, kind, ti)
@@ -118,8 +115,9 @@ def _input_file(fit: dict[str, Any], base: Path) -> tuple[Path, bool]:
         candidates.append(base / given)
     found = [c for c in dict.fromkeys(candidates) if c.is_file()]
     if not found:
-        raise FileNotFoundError(f"measurement file {fit['file']!r} of the fit not found "
-                                f"(looked in {', '.join(str(c) for c in candidates)})")
+        raise FileNotFoundError(f"{base / 'fit.json'}: the fit's measurement file "
+                                f"{fit['file']!r} is not found or is not a file (looked in "
+                                f"{', '.join(str(c) for c in candidates)})")
     digest = fit.get("file_sha256")
     if not digest:
         return found[0], False  # a fit.json of an older roughbrdf
@@ -198,10 +196,12 @@ def _fit_figures(fit_dir: Path, out: Path | None, channel: str | None, force: bo
                  ) -> list[Path]:
     """Draw the comparison of each channel of the fit in ``fit_dir``: into ``out``, or added to
     the fit's results in its folder; everything is checked before the drawing."""
-    from ..fitting.result import read_fit_json
+    from ..fitting.result import check_fit_channels, read_fit_json
     from ..output import ResultFolder
 
-    fit, base = read_fit_json(fit_dir)
+    fit, base = read_fit_json(fit_dir, channels=False)
+    _input_file(fit, base)  # the measurement named first: without it nothing can be drawn
+    check_fit_channels(fit, fit_dir / "fit.json" if fit_dir.is_dir() else fit_dir)
     chans = _fit_channels(fit, channel, out)
     if out is not None:
         _check_out(out, force)

@@ -7,10 +7,10 @@ from typing import Annotated
 
 import typer
 
-from .common import handled
+from .common import REPRODUCE_OPTIONS, handled
 
 #: the library's argument names -> this verb's options (errors name the options)
-OPTIONS = {"paper": "--paper", "out": "--out", "overwrite": "--force", "data_dir": "--data"}
+OPTIONS = REPRODUCE_OPTIONS
 
 
 def register(app: typer.Typer) -> None:

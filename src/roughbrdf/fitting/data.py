@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -37,7 +38,8 @@ if TYPE_CHECKING:
     from ..models import Model
 
 __all__ = ["Comparison", "ChannelData", "DataOptions", "EXCLUSION_REASONS", "channel_weights",
-           "check_fit_domain", "excluded_text", "outside_fit_domain", "prepare_channel", "where"]
+           "check_fit_domain", "check_relative_to", "excluded_text", "outside_fit_domain",
+           "input_source", "prepare_channel", "where"]
 
 #: the reasons a sample is left out or changed, in the order reports list them
 EXCLUSION_REASONS: dict[str, str] = {
@@ -105,6 +107,8 @@ class Comparison:
         """For ``meas``; ``relative_to`` overrides ``meas.meta["relative_to"]`` (default
         ``"brdf"``) for relative data."""
         q = Quantity.parse(meas.quantity)
+        if relative_to is not None:  # checked also for absolute data, where it is unused: a
+            check_relative_to(relative_to)  # typo must not pass silently
         if q.absolute:
             return cls(q.compared_with())
         rel = relative_to or meas.meta.get("relative_to")
@@ -120,6 +124,32 @@ class Comparison:
     def compared(self) -> str:
         """``"brdf"`` or ``"bridf"``."""
         return self.quantity.value
+
+
+#: the values ``relative_to`` takes (what relative data are proportional to)
+RELATIVE_TO = ("brdf", "bridf", "brdf_cos")
+
+
+def check_relative_to(relative_to: object) -> None:
+    """Refuse a ``relative_to`` that is not one of :data:`RELATIVE_TO` (naming the argument).
+
+    Examples
+    --------
+    >>> check_relative_to("bridf")
+    >>> check_relative_to("brfd")
+    Traceback (most recent call last):
+    ...
+    roughbrdf.errors.ArgumentError: relative_to must be 'brdf' or 'bridf' (or 'brdf_cos', the \
+same as 'bridf': what relative values are proportional to), got 'brfd'
+    """
+    try:  # the spellings Quantity.compared_with accepts for relative data
+        ok = Quantity.parse(relative_to, "relative_to").value in RELATIVE_TO
+    except ValueError:
+        ok = False
+    if not ok:
+        raise ArgumentError("relative_to", "relative_to must be 'brdf' or 'bridf' (or "
+                            "'brdf_cos', the same as 'bridf': what relative values are "
+                            f"proportional to), got {relative_to!r}")
 
 
 @dataclass(frozen=True)
@@ -446,5 +476,40 @@ def prepare_channel(model: Model, meas: Measurement, j: int, opts: DataOptions) 
         raise ValueError(f"{place}: no data to fit ({total} samples; left out: "
                          + excluded_text(excluded) + ")"
                          if total else f"{place}: no data to fit (0 samples)")
+    if not np.any(x[idx] > 0):  # all zero (or below): any model with a zero scale "fits",
+        # and the fit would report success at its starting values
+        raise ValueError(f"{place}: no positive value among the {idx.size} samples to fit "
+                         f"(all are 0 or below): nothing to fit a BRDF to")
     return ChannelData(x[idx], _instrument_geometry(meas, idx, opts.aperture),
                        None if w is None else w[idx], label, idx, excluded)
+
+
+def input_source(meas: Measurement) -> dict[str, str | None]:
+    """``{"file", "file_abspath", "file_sha256"}`` of the file ``meas`` was read from.
+
+    ``file`` is ``meta["file"]`` as recorded; ``file_abspath`` and ``file_sha256`` come from
+    the reader's ``meta`` when it recorded them, else from the file itself (read now), and are
+    None when the measurement did not come from a file or the file cannot be read.
+
+    Examples
+    --------
+    >>> from roughbrdf.measurement import Measurement
+    >>> input_source(Measurement([0.1], [0.2], [0.0], [1.0]))
+    {'file': None, 'file_abspath': None, 'file_sha256': None}
+    """
+    meta = meas.meta
+    f = meta.get("file")
+    out: dict[str, str | None] = {"file": None if f is None else str(f),
+                                  "file_abspath": meta.get("file_abspath"),
+                                  "file_sha256": meta.get("file_sha256")}
+    if f is None or (out["file_abspath"] and out["file_sha256"]):
+        return out
+    path = Path(str(out["file_abspath"] or f))
+    if not path.is_file():
+        return out
+    out["file_abspath"] = out["file_abspath"] or str(path.resolve())
+    if not out["file_sha256"]:
+        from ..output import file_sha256
+
+        out["file_sha256"] = file_sha256(path)
+    return out

@@ -7,6 +7,11 @@ reduced chi2, AIC, BIC, TR75's sigma (Eq. 34) and the r.m.s. log residual, the p
 their standard errors, initial values and bounds, the scale ``K``, and the correlations above
 ``min_correl``. ``docs/fitting.md`` shows an example.
 
+Units of angles: a parameter whose unit is an angle (Oren-Nayar ``sigma``) is printed with its
+unit named, in radians (the library's unit, ``angles="rad"``, the default) or in degrees
+(``angles="deg"``: what ``roughbrdf fit`` prints and writes to ``report.txt``); ``fit.json``
+always holds radians.
+
 Honest at bounds: a parameter at a bound (:func:`~roughbrdf.fitting.statistics.at_bound`) is
 printed ``(at the lower bound: no stderr)`` with a note why (the covariance is not meaningful
 at an active bound); a relative error is printed as a percentage only up to 1000 %
@@ -18,6 +23,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from ..errors import ArgumentError
 from .data import excluded_text
 
 if TYPE_CHECKING:
@@ -44,12 +50,19 @@ def fmt(v: float | None, digits: int = 6) -> str:
     return f"{v:.{digits}g}"
 
 
-def report(result: FitResult, *, min_correl: float = 0.1) -> str:
+#: the units a report can show angle parameters in
+ANGLE_UNITS = ("rad", "deg")
+
+
+def report(result: FitResult, *, min_correl: float = 0.1, angles: str = "rad") -> str:
     """The text report of ``result`` (:meth:`FitResult.report
-    <roughbrdf.fitting.FitResult.report>`)."""
+    <roughbrdf.fitting.FitResult.report>`); parameters whose unit is an angle in ``angles``
+    (``"rad"`` or ``"deg"``), with the unit named."""
+    if angles not in ANGLE_UNITS:  # a typo would silently print radians
+        raise ArgumentError("angles", "must be 'rad' or 'deg'", value=angles)
     lines = _header(result)
     for c in result.channels:
-        lines += ["", *_channel(c), *_variables(c), *_correlations(c, min_correl)]
+        lines += ["", *_channel(c), *_variables(c, angles), *_correlations(c, min_correl)]
         # a Mueller fit's channel adds its normalized elements (fitting.polarimetric)
         lines += getattr(c, "report_lines", list)()
     if result.model_choice is not None:
@@ -168,22 +181,37 @@ def percent(se: float | None, val: float | None) -> str:
     return f" ({100 * ratio:.2f}%)" if ratio <= MAX_PERCENT_RATIO else " (> 1000%)"
 
 
-def _variable(c: ChannelFit, name: str, val: float | None) -> str:
+def _angle_parameters(c: ChannelFit) -> set[str]:
+    """The parameters of the channel's model whose unit is an angle (radians)."""
+    model = getattr(c, "model", None)
+    return {p.name for p in getattr(model, "parameters", ()) if p.unit == "rad"}
+
+
+def _variable(c: ChannelFit, name: str, val: float | None, angle: str | None) -> str:
+    """One parameter's line; ``angle`` is the unit of an angle parameter (else None)."""
+    def shown(v: float | None, digits: int = 6) -> str:
+        if v is None or angle is None:
+            return fmt(v, digits)
+        return fmt(math.degrees(v) if angle == "deg" else v, digits)
+
+    unit = f" {angle}" if angle else ""
     if name not in c.free:
-        return "None (switched off)" if val is None else f"{fmt(val, 7)} (fixed)"
+        return "None (switched off)" if val is None else f"{shown(val, 7)}{unit} (fixed)"
     lo, hi = c.bounds[name]
-    tail = f"(init = {fmt(c.init[name])}, bounds [{fmt(lo)}, {fmt(hi)}])"
+    tail = f"(init = {shown(c.init[name])}{unit}, bounds [{shown(lo)}, {shown(hi)}]{unit})"
     side = c.at_bound.get(name)
     if side is not None:
-        return f"{fmt(val, 7)} (at the {side} bound: no stderr) {tail}"
+        return f"{shown(val, 7)}{unit} (at the {side} bound: no stderr) {tail}"
     se = c.stderr.get(name)
-    return f"{fmt(val, 7)} +/- {fmt(se, 4)}{percent(se, val)} {tail}"
+    return f"{shown(val, 7)}{unit} +/- {shown(se, 4)}{unit}{percent(se, val)} {tail}"
 
 
-def _variables(c: ChannelFit) -> list[str]:
+def _variables(c: ChannelFit, angles: str = "rad") -> list[str]:
     width = max(len(n) for n in [*c.params, "scale K"])
     lines = ["[[Variables]]"]
-    lines += [f"    {name:<{width}}: {_variable(c, name, val)}" for name, val in c.params.items()]
+    angular = _angle_parameters(c)
+    lines += [f"    {name:<{width}}: {_variable(c, name, val, angles if name in angular else None)}"
+              for name, val in c.params.items()]
     if c.at_bound:
         names = ", ".join(c.at_bound)
         lines += [f"    ({names} at a bound: no standard error, since the covariance is not "

@@ -23,6 +23,7 @@ import numpy as np
 
 from ..instrument import Aperture, aperture_average
 from ..quantity import Quantity
+from .data import input_source
 from .statistics import Covariance, GoodnessOfFit, at_bound
 
 if TYPE_CHECKING:
@@ -31,8 +32,8 @@ if TYPE_CHECKING:
     from .objective import Objective
     from .search import SearchOutcome
 
-__all__ = ["ChannelFit", "FitResult", "channel_model", "fitted_models", "input_source",
-           "read_fit_json"]
+__all__ = ["ChannelFit", "FitResult", "channel_model", "check_fit_channels", "fitted_models",
+           "input_source", "read_fit_json"]
 
 
 @dataclass
@@ -359,11 +360,12 @@ class FitResult:
             atomic_write(path, text + "\n", overwrite=overwrite)
         return text
 
-    def report(self, *, min_correl: float = 0.1) -> str:
-        """lmfit-style text report of every channel (:func:`roughbrdf.fitting.report.report`)."""
+    def report(self, *, min_correl: float = 0.1, angles: str = "rad") -> str:
+        """lmfit-style text report of every channel (:func:`roughbrdf.fitting.report.report`);
+        parameters whose unit is an angle in ``angles`` (``"rad"`` or ``"deg"``)."""
         from .report import report
 
-        return report(self, min_correl=min_correl)
+        return report(self, min_correl=min_correl, angles=angles)
 
     def __str__(self) -> str:
         return self.report()
@@ -414,7 +416,7 @@ class FitResult:
         return out
 
     def save(self, out_dir: str | os.PathLike, *, plots: bool = True, overwrite: bool = False,
-             dpi: int = 110) -> list[Path]:
+             dpi: int = 110, report_angles: str = "rad") -> list[Path]:
         """Write ``fit.json``, ``report.txt`` and one ``fit_<channel>.png`` per channel, as one set.
 
         Everything goes through :class:`roughbrdf.output.ResultFolder`: the folder may exist,
@@ -435,6 +437,9 @@ class FitResult:
             Replace the set of results in ``out_dir`` (stale files of the old set are removed).
         dpi : int
             Resolution of the PNGs.
+        report_angles : {"rad", "deg"}
+            Unit of the angle parameters in ``report.txt`` (``roughbrdf fit``: degrees);
+            ``fit.json`` holds radians.
 
         Returns
         -------
@@ -443,18 +448,20 @@ class FitResult:
         """
         from ..output import ResultFolder
 
-        files = self.files(plots=plots, dpi=dpi)
+        files = self.files(plots=plots, dpi=dpi, report_angles=report_angles)
         with ResultFolder(out_dir, overwrite=overwrite) as out:
             out.check(list(files))  # refuse before the (slow) drawing
             for name, content in files.items():
                 out.add(name, content, binary=callable(content))
         return [out.path / n for n in files]
 
-    def files(self, *, plots: bool = True, dpi: int = 110) -> dict[str, Any]:
+    def files(self, *, plots: bool = True, dpi: int = 110, report_angles: str = "rad"
+              ) -> dict[str, Any]:
         """The set :meth:`save` writes, for a :class:`~roughbrdf.output.ResultFolder`:
         ``{"fit.json": text, "report.txt": text, "fit_<channel>.png": writer}``; each PNG
-        writer draws its figure only when it is written."""
-        text = self.report()
+        writer draws its figure only when it is written (``report_angles``: as for
+        :meth:`save`)."""
+        text = self.report(angles=report_angles)
         files: dict[str, Any] = {"fit.json": self.to_json() + "\n",
                                  "report.txt": text if text.endswith("\n") else text + "\n"}
         if plots:
@@ -481,54 +488,96 @@ def _figure_writer(draw: Callable[[], Any], dpi: int) -> Callable[[IO[bytes]], N
     return write
 
 
-def input_source(meas: Measurement) -> dict[str, str | None]:
-    """``{"file", "file_abspath", "file_sha256"}`` of the file ``meas`` was read from.
-
-    ``file`` is ``meta["file"]`` as recorded; ``file_abspath`` and ``file_sha256`` come from
-    the reader's ``meta`` when it recorded them, else from the file itself (read now), and are
-    None when the measurement did not come from a file or the file cannot be read.
-
-    Examples
-    --------
-    >>> from roughbrdf.measurement import Measurement
-    >>> input_source(Measurement([0.1], [0.2], [0.0], [1.0]))
-    {'file': None, 'file_abspath': None, 'file_sha256': None}
-    """
-    meta = meas.meta
-    f = meta.get("file")
-    out: dict[str, str | None] = {"file": None if f is None else str(f),
-                                  "file_abspath": meta.get("file_abspath"),
-                                  "file_sha256": meta.get("file_sha256")}
-    if f is None or (out["file_abspath"] and out["file_sha256"]):
-        return out
-    path = Path(str(out["file_abspath"] or f))
-    if not path.is_file():
-        return out
-    out["file_abspath"] = out["file_abspath"] or str(path.resolve())
-    if not out["file_sha256"]:
-        from ..output import file_sha256
-
-        out["file_sha256"] = file_sha256(path)
-    return out
+#: the largest ``fit.json`` read (a fit's is a few kB per channel; a device or a huge file
+#: given by mistake must not be read into memory)
+MAX_FIT_JSON_BYTES = 64 * 2**20
 
 
-def read_fit_json(fit: str | os.PathLike) -> tuple[dict[str, Any], Path]:
+def read_fit_json(fit: str | os.PathLike, *, channels: bool = True
+                  ) -> tuple[dict[str, Any], Path]:
     """The content of a fit's ``fit.json`` (``fit`` is the file or its folder) and its folder.
 
-    Raises ``FileNotFoundError`` without one, ``ValueError`` when it is not a fit's JSON.
+    Raises ``FileNotFoundError`` without one, ``ValueError`` naming the file and what is wrong
+    when it is not a fit's JSON: not an object, a key missing or of the wrong type, an aperture
+    that is not one; and with ``channels`` (:func:`check_fit_channels`) a channel without
+    ``params``, with values that are not finite numbers, or a model that cannot be rebuilt.
     """
     path = Path(fit)
     path = path / "fit.json" if path.is_dir() else path
-    if not path.is_file():
+    if not path.is_file():  # also a device (/dev/zero): never read
         raise FileNotFoundError(f"{path}: no fit.json (run `roughbrdf fit FILE --out DIR` first)")
+    if path.stat().st_size > MAX_FIT_JSON_BYTES:
+        raise ValueError(f"{path}: {path.stat().st_size} bytes, too large for a fit.json")
     try:
-        content = json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{path}: not valid JSON ({exc})") from exc
+        content = json.loads(path.read_text(encoding="utf-8"))
+    except (ValueError, RecursionError) as exc:  # bad JSON or UTF-8, a 5000-digit number, nesting
+        raise ValueError(f"{path}: not valid JSON ({' '.join(str(exc).split())})") from exc
+    problem = _fit_json_problem(content)
+    if problem:
+        raise ValueError(f"{path}: not a fit's JSON: {problem}")
+    if channels:
+        check_fit_channels(content, path)
+    return content, path.parent
+
+
+def check_fit_channels(content: dict[str, Any], path: str | os.PathLike) -> None:
+    """Refuse (``ValueError`` naming ``path``) channels of a ``fit.json`` ``content`` that are
+    not a fit's: not a non-empty list of objects with ``channel`` and ``params`` (finite
+    numbers or null), or whose model cannot be rebuilt (:func:`channel_model`)."""
+    problem = _channels_problem(content["channels"])
+    if problem:
+        raise ValueError(f"{path}: not a fit's JSON: {problem}")
+    for i, chan in enumerate(content["channels"]):
+        try:  # rebuilt now, so that a bad value is named here and not deep in a plot
+            channel_model(content, chan)
+        except (ValueError, TypeError, KeyError, AttributeError, OverflowError,
+                RecursionError) as exc:
+            raise ValueError(f"{path}: channel {i} ({chan['channel']!r}): not a model "
+                             f"roughbrdf can rebuild: {' '.join(str(exc).split())}") from None
+
+
+def _fit_json_problem(content: Any) -> str:
+    """What makes ``content`` not the content of a ``fit.json``, channels aside ("" if nothing)."""
+    if not isinstance(content, dict):
+        return f"a JSON {type(content).__name__}, not an object"
     for key in ("model", "file", "channels"):
         if key not in content:
-            raise ValueError(f"{path}: missing key {key!r}")
-    return content, path.parent
+            return f"missing key {key!r}"
+    if not isinstance(content["model"], dict | str) or not content["model"]:
+        return f"'model' must be a model name or spec, got {content['model']!r:.60}"
+    for key in ("file", "file_abspath", "file_sha256", "quantity", "relative_to", "loss"):
+        if content.get(key) is not None and not isinstance(content[key], str):
+            return f"{key!r} must be text, got {content[key]!r:.60}"
+    ap = content.get("aperture")
+    if ap is not None:
+        if not isinstance(ap, dict) or "half_angle_rad" not in ap:
+            return f"'aperture' must be null or an object with 'half_angle_rad', got {ap!r:.60}"
+        try:
+            Aperture.parse(ap["half_angle_rad"], ap.get("points", 19))
+        except (ValueError, TypeError, OverflowError) as exc:
+            return f"'aperture' {ap!r:.60}: {exc}"
+    return ""
+
+
+def _channels_problem(chans: Any) -> str:
+    """What makes ``chans`` not the ``channels`` of a ``fit.json`` ("" when nothing)."""
+    def number(v: Any) -> bool:  # finite, and an int within the float range
+        return type(v) in (int, float) and abs(v) < 1e308 and math.isfinite(float(v))
+
+    if not isinstance(chans, list) or not chans:
+        return "'channels' must be a non-empty list"
+    for i, c in enumerate(chans):
+        params = c.get("params") if isinstance(c, dict) else None
+        if not isinstance(c, dict) or not isinstance(c.get("channel"), str | int) \
+                or not isinstance(params, dict):
+            return f"channel {i} must be an object with 'channel' and 'params', got {c!r:.60}"
+        bad = [k for k, v in params.items() if v is not None and not number(v)]
+        if bad:
+            return (f"channel {i} ({c['channel']!r}): parameter {bad[0]!r} = "
+                    f"{params[bad[0]]!r:.40} is not a finite number")
+        if c.get("model_spec") is not None and not isinstance(c["model_spec"], dict):
+            return f"channel {i} ({c['channel']!r}): 'model_spec' must be an object"
+    return ""
 
 
 def channel_model(fit: dict[str, Any], chan: dict[str, Any]) -> Model:

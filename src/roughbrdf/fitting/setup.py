@@ -20,7 +20,7 @@ from ..errors import ArgumentError
 from ..measurement import Measurement
 from ..models import Model, Parameter
 from ..quantity import Quantity
-from .data import ChannelData, Comparison, DataOptions, where
+from .data import ChannelData, Comparison, DataOptions, input_source, where
 from .objective import ObjectiveSpec
 
 __all__ = ["BoundsFix", "FitPlan", "FreeParameters", "as_model", "channel_indices",
@@ -254,8 +254,6 @@ class FitPlan:
                       **options: Any) -> dict[str, Any]:
         """The fields of a :class:`~roughbrdf.fitting.result.FitResult` of this plan besides
         its channels; ``options`` adds to (or sets) the recorded ``options``."""
-        from .result import input_source
-
         ap = self.opts.aperture
         return {"measurement": measurement, "model_name": model_label(self.model),
                 "loss": self.spec.loss, "compared": self.opts.comparison.compared,

@@ -162,6 +162,16 @@ def test_astm_num_points_refuses_an_underscore_number(tmp_path):
     assert info.value.line == 3
 
 
+def test_astm_polarization_header_refuses_an_underscore_number(tmp_path):
+    """Why: ``POLARIZATION 0_5`` was read as 5 (radians)."""
+    p = tmp_path / "p.astm"
+    p.write_text(ASTM_HEAD.replace("NUM_POINTS", "POLARIZATION 0_5\nNUM_POINTS")
+                 + "\n".join(ASTM_ROWS) + "\n", encoding="utf-8")
+    with pytest.raises(FormatError, match=r"0_5") as info:
+        rb.read(p)
+    assert info.value.line == 3
+
+
 @pytest.mark.parametrize("fmt", ["csv", "astm", "alta"])
 def test_plain_numbers_still_read(tmp_path, fmt):
     """nan (a value), signs, exponents and blanks around commas read as always."""
@@ -231,3 +241,31 @@ def test_a_mini_diff_file_reads_without_warning(shared_data):
         m = rb.read(path)
     assert m.n_samples == 12964
     assert not re.search("look like", str(m.meta))
+
+
+ZEMAX = ("# hand-written test file\nSource\tMeasured\nSymmetry\tPlaneSymmetrical\n"
+         "SpectralContent\tMonochrome\nScatterType\tBRDF\n\nSampleRotation\t1\n0\n"
+         "AngleOfIncidence\t1\n30\nScatterAzimuth\t3\n0\t90\t180\nScatterRadial\t3\n0\t10\t20\n"
+         "\nMonochrome\nDataBegin\nTIS\t0.5\n0.1\t0.11\t0.12\n0.1\t0.11\t0.12\n0.1\t0.11\t0.12\n"
+         "DataEnd\n")
+
+
+@pytest.mark.parametrize("old, new, line, reason", [
+    ("0\t10\t20", "0\t1_0\t20", 14, r"non-numeric angle '1_0'"),
+    ("TIS\t0.5", "TIS\t0_5", 18, r"a TIS line holds 'TIS' and one number"),
+    ("0.1\t0.11\t0.12\nDataEnd", "0.1\t0.1_1\t0.12\nDataEnd", 21, r"'_' in the field '0.1_1'"),
+    ("0.1\t0.11\t0.12\nDataEnd", "0.1\t０.11\t0.12\nDataEnd", 21, r"non-ASCII characters U\+FF10"),
+])
+def test_zemax_numbers_that_are_not_plain_ascii_are_refused(tmp_path, old, new, line, reason):
+    """Why: the Zemax reader read ``1_0`` as 10 in its angle lists, its TIS and its rows."""
+    p = tmp_path / "t.bsdf"
+    p.write_text(ZEMAX.replace(old, new), encoding="utf-8")
+    with pytest.raises(FormatError, match=reason) as info:
+        rb.read(p)
+    assert info.value.line == line
+
+
+def test_zemax_sample_reads(tmp_path):
+    p = tmp_path / "t.bsdf"
+    p.write_text(ZEMAX, encoding="utf-8")
+    assert rb.read(p).n_samples > 0

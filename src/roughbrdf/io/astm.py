@@ -77,6 +77,7 @@ from ._rows import (
     begin_read,
     check_row_count,
     count_fields,
+    parse_number,
     parse_rows,
     row_separator,
     rows_from,
@@ -339,7 +340,7 @@ def _polarization_value(key: str, val: str, unit: AngleUnit, path: Path,
     """One polarization declaration: an angle in the file's unit, or ``s``/``p``/
     ``unpolarized`` (NaN; also ``nan``)."""
     try:
-        g = float(val) * unit.factor
+        g = parse_number(val) * unit.factor
     except ValueError:
         try:
             return polarization_angle(val.lower())

@@ -114,7 +114,7 @@ from ._common import (
     unit_word,
     warn_not_written,
 )
-from ._rows import begin_read, parse_rows
+from ._rows import begin_read, parse_number, parse_rows
 
 __all__ = ["read", "write", "read_table", "write_table", "table_integral", "plan",
            "specular_to_common", "common_to_specular", "grid_from_radians",
@@ -423,7 +423,7 @@ def _read_counted(tok: _Tokens, k: int, key: str, path: Path) -> tuple[list[floa
     if k + 1 >= len(tok.words):
         raise FormatError(f"{key} has no count (expected '{key} N' and N angles)", path, line)
     try:
-        count = float(tok.words[k + 1])
+        count = parse_number(tok.words[k + 1])
     except ValueError:
         count = math.nan
     if not (math.isfinite(count) and count >= 1 and count.is_integer()):
@@ -434,7 +434,7 @@ def _read_counted(tok: _Tokens, k: int, key: str, path: Path) -> tuple[list[floa
     j = k + 2
     while j < len(tok.words) and _keyword(tok.words[j]) is None:
         try:
-            vals.append(float(tok.words[j]))
+            vals.append(parse_number(tok.words[j]))
         except ValueError:
             raise FormatError(f"non-numeric angle {tok.words[j]!r} after {key} (line "
                               f"{line})", path, tok.lines[j]) from None
@@ -568,7 +568,7 @@ def _tis_values(tis: list[tuple[str, int]], path: Path) -> np.ndarray:
         try:
             if len(parts) != 2:
                 raise ValueError
-            out.append(float(parts[1]))
+            out.append(parse_number(parts[1]))
         except ValueError:
             raise FormatError(f"a TIS line holds 'TIS' and one number, got {s[:40]!r}", path,
                               ln) from None

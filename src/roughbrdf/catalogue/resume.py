@@ -4,7 +4,11 @@ Each per-file fit folder of a catalogue holds, besides the fit's own files, :dat
 (written in the same all-or-nothing set, :class:`roughbrdf.output.ResultFolder`):
 ``{"sha256": input hash, "fingerprint": model + options, "files": [...], "rows": [...]}``.
 An input is skipped when that file exists, its ``sha256`` and ``fingerprint`` equal the new
-run's, and every file it lists is in the folder and in the folder's manifest (a complete set).
+run's, and every file it lists (and the task file itself) is in the folder with the SHA-256 the
+folder's manifest records for it: a complete set, byte for byte. A commit a killed run left
+half done is first rolled forward or back (:func:`roughbrdf.output.recover`); a file altered
+or truncated since, a manifest of an older version (no hashes), a manifest roughbrdf will not
+trust or a folder another live run is writing into count as not complete.
 
 Examples
 --------
@@ -39,22 +43,28 @@ def completed_rows(folder: str | Path, sha256: str | None,
                    fp: str) -> list[dict[str, Any]] | None:
     """The rows of the complete earlier result in ``folder`` for this input and fingerprint,
     marked ``"skipped (resume)"``; None if there is none (or it differs, or is incomplete)."""
-    from ..output import MANIFEST
+    from ..output import JOURNAL, read_manifest, recover
 
     folder = Path(folder)
     if sha256 is None:
         return None
     try:
+        recover(folder)  # a killed run's commit is rolled forward or back first
+        listed = read_manifest(folder)
         task = json.loads((folder / TASK_FILE).read_text(encoding="utf-8"))
-        listed = set(json.loads((folder / MANIFEST).read_text(encoding="utf-8")))
-    except (OSError, ValueError):
+    except (OSError, ValueError):  # OverwriteRefused is an OSError: an untrusted record
+        return None
+    if (folder / JOURNAL).exists():  # a live run is committing there right now
         return None
     if not isinstance(task, dict) or task.get("sha256") != sha256 \
             or task.get("fingerprint") != fp:
         return None
     files = [str(f) for f in task.get("files", [])]
-    if not all(f in listed and (folder / f).is_file() for f in [*files, TASK_FILE]):
-        return None
+    for f in [*files, TASK_FILE]:
+        digest = listed.get(f)
+        # the hash the commit recorded, and the bytes now: both known and equal
+        if digest is None or not (folder / f).is_file() or file_sha256(folder / f) != digest:
+            return None
     rows = task.get("rows")
     if not isinstance(rows, list) or not rows:
         return None

@@ -46,9 +46,12 @@ from urllib.parse import quote, urlsplit
 
 import numpy as np
 
-from ..output import atomic_write, ensure_folder, refuse_existing
+from ..output import ResultFolder, ensure_folder, refuse_existing
 
-__all__ = ["write_summary", "STATUSES"]
+__all__ = ["write_summary", "STATUSES", "SUMMARY_FILES"]
+
+#: the pages :func:`write_summary` writes
+SUMMARY_FILES = ("summary.md", "summary.html")
 
 #: the statuses of a row, in the order the counts list them
 STATUSES = ("ok", "not converged", "failed", "skipped (resume)")
@@ -434,7 +437,7 @@ def _markdown(rows: Sequence[Mapping[str, Any]], title: str, page_size: int) -> 
 
 def write_summary(out_dir: str | os.PathLike, rows: Iterable[Mapping[str, Any]], *,
                   title: str | None = None, page_size: int = 100, max_thumbnails: int = 60,
-                  overwrite: bool = False) -> list[Path]:
+                  overwrite: bool = False, into: ResultFolder | None = None) -> list[Path]:
     """Write ``summary.md`` and ``summary.html`` of a catalogue fit into ``out_dir``.
 
     Parameters
@@ -452,6 +455,11 @@ def write_summary(out_dir: str | os.PathLike, rows: Iterable[Mapping[str, Any]],
     overwrite : bool
         Replace existing summary files (default: refuse with
         :class:`roughbrdf.output.OverwriteRefused` before writing anything).
+    into : roughbrdf.output.ResultFolder, optional
+        An open set on ``out_dir`` (the catalogue's, holding ``catalogue.csv`` and
+        ``catalogue.json``): the two pages are staged into it and committed with it, so the
+        catalogue files and their summary are one set. Without it the pages are written as a
+        set of their own, added to the folder's (``extend=True``): both old or both new.
 
     Returns
     -------
@@ -459,12 +467,22 @@ def write_summary(out_dir: str | os.PathLike, rows: Iterable[Mapping[str, Any]],
         ``[summary.md, summary.html]``.
     """
     folder = ensure_folder(out_dir)
-    md_path, html_path = folder / "summary.md", folder / "summary.html"
+    md_path, html_path = folder / SUMMARY_FILES[0], folder / SUMMARY_FILES[1]
+    if into is not None and Path(into.path).resolve() != folder.resolve():
+        raise ValueError(f"into is a set on {into.path}, not on out_dir {folder}")
     refuse_existing(md_path, overwrite)
     refuse_existing(html_path, overwrite)
     rows = list(rows)
     title = title or f"Catalogue summary: {folder.resolve().name}"
     page = _html_page(rows, title, page_size, max_thumbnails)
-    atomic_write(md_path, _markdown(rows, title, page_size), overwrite=overwrite)
-    atomic_write(html_path, page, overwrite=overwrite)
+    pages = {md_path.name: _markdown(rows, title, page_size), html_path.name: page}
+    if into is not None:
+        for name, text in pages.items():
+            into.add(name, text)
+        return [md_path, html_path]
+    # earlier versions wrote the pages outside any set: with overwrite they are replaced
+    with ResultFolder(folder, overwrite=overwrite, extend=True, adopt=SUMMARY_FILES) as out:
+        out.check(pages)
+        for name, text in pages.items():
+            out.add(name, text)
     return [md_path, html_path]

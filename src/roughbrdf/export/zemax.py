@@ -34,7 +34,7 @@ import math
 import os
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -352,11 +352,39 @@ def to_zemax(model_or_fit: Any, out: str | os.PathLike, *, angles_of_incidence: 
     targets = _targets(out, [c for c, _ in pairs], single=len(pairs) == 1 and (
         isinstance(model_or_fit, Model) or channel is not None))
     _check_targets(targets, overwrite)
+    grids = [_grid(mdl, angles_of_incidence, radial, azimuth, symmetry, polarization)
+             for _, mdl in pairs]
+    if len(targets) == 1:  # one file: written atomically on its own
+        return ZemaxExport([_write_one(pairs[0][1], pairs[0][0], grids[0], targets[0],
+                                       polarization, overwrite)])
+    return ZemaxExport(_write_set(pairs, grids, targets, polarization, overwrite))
+
+
+def _write_set(pairs: list[tuple[str | None, Model]], grids: list[ZemaxGrid],
+               targets: list[Path], polarization: Any, overwrite: bool) -> list[ZemaxFile]:
+    """The channels' files as one set (:class:`roughbrdf.output.ResultFolder`, added to the
+    folder's set): a kill or an error leaves all the old files or all the new ones.
+
+    Each table is written to a scratch folder first (``write_table`` writes to a path), then
+    staged into the set; the user named the files, so with ``overwrite`` an existing file of
+    those names that no set lists is replaced (``adopt``) unless the manifest says it changed.
+    """
+    import tempfile
+
+    from ..output import ResultFolder
+
     files = []
-    for (label, mdl), path in zip(pairs, targets, strict=True):
-        grid = _grid(mdl, angles_of_incidence, radial, azimuth, symmetry, polarization)
-        files.append(_write_one(mdl, label, grid, path, polarization, overwrite))
-    return ZemaxExport(files)
+    with tempfile.TemporaryDirectory(prefix="roughbrdf-zemax-") as scratch, \
+            ResultFolder(targets[0].parent, overwrite=overwrite, extend=True,
+                         adopt=[p.name for p in targets]) as out:
+        out.check([p.name for p in targets])  # before the (slow) tables
+        for (label, mdl), grid, path in zip(pairs, grids, targets, strict=True):
+            tmp = Path(scratch) / path.name
+            done = _write_one(mdl, label, grid, tmp, polarization, True)
+            out.add(path.name, tmp.read_bytes())
+            tmp.unlink()
+            files.append(replace(done, path=path))
+    return files
 
 
 def _grid(model: Model, angles_of_incidence: Any, radial: Any, azimuth: Any, symmetry: str,

@@ -1,7 +1,8 @@
 """The result of one reproduction (figure + the numbers behind it) and how it is written.
 
 Files are written atomically and never replace a file unless asked (``overwrite=True``; the
-CLI's ``--force``): :mod:`roughbrdf.output`.
+CLI's ``--force``), and several files of one reproduction or one run are written as one set
+(:class:`roughbrdf.output.ResultFolder`): :mod:`roughbrdf.output`.
 """
 
 from __future__ import annotations
@@ -126,18 +127,24 @@ class Reproduction:
         """Write the PNG, CSV(s) and Markdown into ``out``; refuse to replace a file unless
         ``overwrite``.
 
-        Every file is written atomically (:func:`roughbrdf.output.atomic_write`) after all of
-        them were checked. ``compact`` stores the PNG with a 256-colour palette (about a third
-        of the size; used for the images committed under ``docs/img``).
+        The files are checked first, then written as one set added to the folder's
+        (:class:`roughbrdf.output.ResultFolder` with ``extend=True``): an error, Ctrl-C or a
+        kill leaves all the old files or all the new ones. The caller named the folder, so
+        with ``overwrite`` files of these names that no set lists are replaced (``adopt``).
+        ``compact`` stores the PNG with a 256-colour palette (about a third of the size; used
+        for the images committed under ``docs/img``).
         """
-        from ..output import atomic_write, ensure_folder
+        from ..output import ResultFolder, ensure_folder
 
         out = ensure_folder(out)
         paths = self.outputs(out)
         check_writable(paths, overwrite)
-        for path, content in zip(paths, self.files(dpi=dpi, compact=compact).values(),
-                                 strict=True):
-            atomic_write(path, content, overwrite=overwrite, binary=callable(content))
+        with ResultFolder(out, overwrite=overwrite, extend=True,
+                          adopt=[p.name for p in paths]) as folder:
+            folder.check([p.name for p in paths])
+            for path, content in zip(paths, self.files(dpi=dpi, compact=compact).values(),
+                                     strict=True):
+                folder.add(path.name, content, binary=callable(content))
         return paths
 
 

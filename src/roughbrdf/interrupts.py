@@ -195,14 +195,29 @@ def checkpoint(name: str) -> None:
 
     :func:`roughbrdf.cli.main` calls it between its last statements, so that a test can inject
     Ctrl-C at each of them deterministically instead of by timing.
+
+    Parameters
+    ----------
+    name : str
+        The point, as the hook receives it (``"main: status settled"``).
     """
     if _checkpoint_hook:  # no hook outside tests: nothing to do
         _checkpoint_hook[0](name)
 
 
 def set_checkpoint_hook(hook: Callable[[str], None] | None) -> Callable[[str], None] | None:
-    """Install ``hook`` (called with each :func:`checkpoint`'s name), or remove it (``None``);
-    returns the previous one. For tests only."""
+    """Install ``hook`` (called with each :func:`checkpoint`'s name), or remove it. For tests.
+
+    Parameters
+    ----------
+    hook : callable or None
+        Called as ``hook(name)`` at every :func:`checkpoint`; None removes the hook.
+
+    Returns
+    -------
+    callable or None
+        The hook installed before (to put back when the test ends).
+    """
     previous = _checkpoint_hook[0] if _checkpoint_hook else None
     _checkpoint_hook.clear()
     if hook is not None:

@@ -65,6 +65,14 @@ def test_utf16_and_utf32_files_with_a_byte_order_mark_are_read(tmp_path, encodin
     assert m.meta["sample"] == "S1"
 
 
+def test_a_utf16_file_of_unknown_extension_is_recognized_by_its_contents(tmp_path):
+    """Why: the contents were looked at as UTF-8 only: a UTF-16 ASTM file named ``.txt`` was an
+    'unknown format'."""
+    p = tmp_path / "u.txt"
+    p.write_bytes(ASTM.encode("utf-16"))
+    np.testing.assert_array_equal(rb.read(p).values, _expected())
+
+
 @pytest.mark.parametrize("encoding", ["utf-16-le", "utf-16-be"])
 @pytest.mark.parametrize("fmt, text, ext", [("astm", ASTM, ".astm"), ("csv", CSV, ".csv")])
 def test_utf16_without_byte_order_mark_is_refused_naming_utf16(tmp_path, encoding, fmt, text,

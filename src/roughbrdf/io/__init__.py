@@ -64,6 +64,7 @@ from ._common import (
     LossyWriteWarning,
     UnterminatedRowWarning,
 )
+from ._rows import decode
 
 __all__ = ["read", "write", "FormatError", "FormatWarning", "ImplausibleAnglesWarning",
            "LossyWriteWarning", "UnterminatedRowWarning", "FORMATS", "format_for"]
@@ -112,7 +113,10 @@ def _sniff(path: Path) -> str | None:
         dims = np.frombuffer(head[:12], dtype="<i4")
         if dims.tolist() == [90, 90, 180]:
             return "merl"
-    text = head.decode("utf-8", errors="replace")
+    try:
+        text = decode(head, path)  # UTF-16/32 by their byte-order mark, as the readers do
+    except FormatError:
+        return None  # NUL bytes and no byte-order mark: no text format
     if text.lstrip().startswith("# roughbrdf-csv"):
         return "csv"
     if re.search(r"^#DIM\s+\d+\s+\d+", text, re.MULTILINE):

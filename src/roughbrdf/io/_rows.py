@@ -30,8 +30,8 @@ from ..quantity import Quantity
 from ._common import FormatError, UnterminatedRowWarning, data_lines, outside_stacklevel
 
 __all__ = ["MAX_STREAM_BYTES", "read_text", "begin_read", "is_number", "parse_number",
-           "split_fields", "parse_rows", "whole_number", "check_row_count", "count_fields",
-           "row_separator", "rows_from"]
+           "split_fields", "parse_rows", "decode", "whole_number", "check_row_count",
+           "count_fields", "row_separator", "rows_from"]
 
 #: the most bytes read from a file that is not a regular file (a pipe, ``/dev/zero``...), whose
 #: size is not known beforehand: 1 GiB, far beyond any measurement; beyond it the file is refused
@@ -55,7 +55,7 @@ _BOMS = ((codecs.BOM_UTF32_LE, "utf-32", "UTF-32"), (codecs.BOM_UTF32_BE, "utf-3
 # --------------------------------------------------------------------------------------------
 # the file's text
 # --------------------------------------------------------------------------------------------
-def _check_no_nul(data: bytes, path: Path) -> None:
+def _check_no_nul(data: bytes, path: str | os.PathLike | None) -> None:
     """A file with NUL bytes and no byte-order mark is no UTF-8 text: refuse it, saying what it
     may be (read as UTF-8 it gives one NUL per character and nonsense keys)."""
     k = data.find(b"\0")
@@ -87,7 +87,7 @@ def _read_bytes(path: Path) -> bytes:
     return b"".join(parts)
 
 
-def _decode(data: bytes, path: Path) -> str:
+def decode(data: bytes, path: str | os.PathLike | None) -> str:
     """The text of a file: UTF-16/32 by its byte-order mark, else UTF-8 (with or without a
     mark; undecodable bytes become U+FFFD, as a stray Latin-1 byte in a comment always did)."""
     for bom, codec, _ in _BOMS:
@@ -108,7 +108,7 @@ def read_text(path: str | os.PathLike) -> list[str]:
         raise FileNotFoundError(f"{p}: no such file")
     if p.is_dir():
         raise FormatError("is a directory, not a measurement file", p)
-    text = _decode(_read_bytes(p), p)
+    text = decode(_read_bytes(p), p)
     lines = text.splitlines()
     if lines and text[-1] in _NUMBER_END and not lines[-1].lstrip().startswith("#"):
         tail = lines[-1].strip()[-24:]

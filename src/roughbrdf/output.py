@@ -9,7 +9,16 @@ Every file roughbrdf writes goes through :func:`atomic_write` (one file) or
   target (:func:`os.replace`, atomic on POSIX and Windows): a reader, a crash or Ctrl-C sees the
   old file or the new one, never a mix and never a 0-byte file;
 * if writing fails or is interrupted, the temporary file is removed and the error propagates;
-  an :class:`OSError` names the file or folder it is about, not the temporary file.
+  an :class:`OSError` names the file or folder it is about, not the temporary file;
+* temporary files are named ``.roughbrdf-tmp-<pid>-...`` (:data:`TMP_PREFIX`, then the
+  writing process's id): one left by a killed process is recognised and removed by the next
+  run (:func:`recover`), one of a live process never.
+
+A :class:`ResultFolder` set survives a kill at any instant: its commit goes through a journal
+(:data:`JOURNAL`, :mod:`roughbrdf.journal`) that the next run into the folder rolls forward or
+back, and its manifest (:data:`MANIFEST`, ``{name: sha256}``) is trusted only as far as it names
+plain files of the folder (:class:`ManifestRefused` otherwise) and only for files whose bytes
+still have the recorded hash (a file changed since is the user's and is never replaced).
 
 Examples
 --------

@@ -12,6 +12,10 @@ schema below) and writes, in the catalogue folder:
   figures each linking to its fit folder, and a histogram (inline SVG) of every fitted
   parameter and of the residual across the catalogue.
 
+The two pages are one set (:class:`roughbrdf.output.ResultFolder`): added to the folder's set,
+or, given ``into=`` (the catalogue's own open set), committed with ``catalogue.csv`` and
+``catalogue.json``; a kill leaves both old pages or both new ones.
+
 The thumbnails are the per-fit PNGs referenced by relative path, not embedded: the page lives
 in the catalogue folder beside them, and embedding 60 figures as data URIs would add several
 megabytes to a page that must stay small at 100,000 rows. The page fetches nothing else.

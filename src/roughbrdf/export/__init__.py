@@ -137,27 +137,16 @@ def _write_mitsuba(files: dict[Path, dict[str, Any]], target: str, overwrite: bo
                    ) -> list[Path]:
     """Each BSDF as a Mitsuba document: the dict as JSON (``mitsuba.load_dict(json.load(f))``)
     or an XML ``<bsdf version="3.0.0">`` (``mitsuba.load_file``/``load_string``); every file
-    checked before the first is written; one file is written atomically, several (one per
-    channel, in one folder) as one set added to the folder's
-    (:class:`roughbrdf.output.ResultFolder`): a kill leaves all the old files or all the new."""
-    from ..output import ResultFolder, atomic_write, refuse_existing
+    checked before the first is written, each written atomically."""
+    from ..output import atomic_write, refuse_existing
     from .mitsuba import xml_text
 
     for path in files:
         refuse_existing(path, overwrite)
-    texts = {path: (json.dumps(bsdf, indent=2, allow_nan=False) if target == "mitsuba"
-                    else xml_text(bsdf, version="3.0.0")) + "\n"
-             for path, bsdf in files.items()}
-    if len(texts) == 1:
-        for path, text in texts.items():
-            atomic_write(path, text, overwrite=overwrite)
-        return list(files)
-    folder = next(iter(files)).parent  # the channels' files sit side by side
-    # the user named these files: with overwrite, unlisted ones of these names are replaced
-    with ResultFolder(folder, overwrite=overwrite, extend=True,
-                      adopt=[p.name for p in files]) as out:
-        for path, text in texts.items():
-            out.add(path.name, text)
+    for path, bsdf in files.items():
+        text = (json.dumps(bsdf, indent=2, allow_nan=False) if target == "mitsuba"
+                else xml_text(bsdf, version="3.0.0"))
+        atomic_write(path, text + "\n", overwrite=overwrite)
     return list(files)
 
 #: ``rb.export_to``: ``rb.export`` is this package

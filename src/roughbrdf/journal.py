@@ -11,14 +11,18 @@
   :class:`BadRecord` and nothing is done.
 * The **commit journal** (:data:`JOURNAL`) is written (and fsynced, the folder too) before the
   first rename of a commit: the new files (name, staged temporary file, SHA-256, and the
-  backup name the old file of that name is renamed to), the stale files of the old set (renamed
-  to backup names too), the new manifest and the old one. Then the files are renamed, the folder
-  fsynced, the manifest written, the backups and the journal removed.
+  backup name, :data:`BACKUP_PREFIX`, the old file of that name is renamed to), the stale files
+  of the old set (renamed to backup names too), the new manifest and the old one. Then the
+  files are renamed, the folder fsynced, the manifest written, the backups and the journal
+  removed.
 * **Recovery** (:func:`recover_locked`, with the folder's lock held): a journal left by a
   killed process is rolled **forward** when every new file is still there with its journalled
   hash (as the staged temporary file or already under its name), else rolled **back**: the
   backups are renamed back, the new files removed, the old manifest restored. Either way the
-  folder holds the old set or the new one, never a mix. Then the temporary files of processes
+  folder holds the old set or the new one, never a mix (the old files stay under their backup
+  names until the new manifest is on disk, so rolling back restores them). Backups, unlike
+  temporary files, are never removed while their journal exists. Then the temporary files of
+  processes
   that no longer exist are removed (their names hold the process id,
   ``.roughbrdf-tmp-<pid>-...``; older names without one are removed too, the caller holding
   the lock).
@@ -37,12 +41,17 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-__all__ = ["TMP_PREFIX", "MANIFEST", "LOCK", "JOURNAL", "BadRecord", "file_sha256",
-           "lock_is_stale", "pid_alive", "tmp_prefix", "fsync_folder", "read_manifest",
-           "commit_set", "recover_locked", "remove_dead_temps"]
+__all__ = ["TMP_PREFIX", "BACKUP_PREFIX", "MANIFEST", "LOCK", "JOURNAL", "BadRecord",
+           "file_sha256", "lock_is_stale", "pid_alive", "tmp_prefix", "fsync_folder",
+           "name_problem", "parse_manifest", "read_manifest", "manifest_text", "commit_set",
+           "recover_locked", "remove_dead_temps"]
 
 #: prefix of the temporary files (a leftover one, after a power cut, is recognizable)
 TMP_PREFIX = ".roughbrdf-tmp-"
+#: prefix of the old files a commit renamed aside (not :data:`TMP_PREFIX`: a cleaner that removes
+#: temporary files, as older versions' did, cannot take them; the journal's recovery then
+#: restores the old set)
+BACKUP_PREFIX = ".roughbrdf-old-"
 #: the record of the files roughbrdf wrote into a results folder (JSON ``{name: sha256}``)
 MANIFEST = ".roughbrdf-outputs"
 #: present while a run writes into the folder (holds its process id)
@@ -148,7 +157,7 @@ def name_problem(folder: Path, name: Any) -> str | None:
         return "a path, not a file name of the folder"
     if name in (".", "..") or os.path.isabs(name):
         return "outside the folder"
-    if name in (MANIFEST, LOCK, JOURNAL) or name.startswith(TMP_PREFIX):
+    if name in (MANIFEST, LOCK, JOURNAL) or name.startswith((TMP_PREFIX, BACKUP_PREFIX)):
         return "one of roughbrdf's own records"
     p = folder / name
     if p.is_symlink():
@@ -211,7 +220,7 @@ def manifest_text(files: dict[str, str | None]) -> str:
 
 
 def _backup_name(name: str) -> str:
-    return f"{tmp_prefix()}{secrets.token_hex(4)}-old-{name}"
+    return f"{BACKUP_PREFIX}{os.getpid()}-{secrets.token_hex(4)}-{name}"
 
 
 def commit_set(folder: Path, new: dict[str, tuple[str, str]], stale: list[str],
@@ -298,8 +307,9 @@ def _load_journal(folder: Path, text: str) -> dict[str, Any]:
         for e in [*new, *stale]:
             names = [e["name"], e.get("tmp"), e["backup"]]
             ok = ok and name_problem(folder, e["name"]) is None and all(
-                n is None or (isinstance(n, str) and n.startswith(TMP_PREFIX)
-                              and name_problem(folder, "x" + n) is None) for n in names[1:])
+                n is None or (isinstance(n, str) and n.startswith((TMP_PREFIX, BACKUP_PREFIX))
+                              and name_problem(folder, "x" + n) is None)
+                for n in names[1:])
             ok = ok and (e in stale or (isinstance(e["tmp"], str) and isinstance(
                 e["sha256"], str)))
     except (ValueError, KeyError, TypeError, AttributeError):
@@ -329,15 +339,19 @@ def recover_locked(folder: str | os.PathLike) -> list[Path]:
         record = _load_journal(folder, text)
         (_roll_forward if _complete(folder, record) else _roll_back)(folder, record)
         done.append(folder / JOURNAL)
-    return done + remove_dead_temps(folder, old_names=True)
+    # no journal is left: a backup of a dead process is an orphan (its journal was deleted)
+    return done + remove_dead_temps(folder, old_names=True, prefix=BACKUP_PREFIX) \
+        + remove_dead_temps(folder, old_names=True)
 
 
-def remove_dead_temps(folder: Path, *, old_names: bool) -> list[Path]:
-    """Remove the temporary files of processes that no longer exist (``old_names``: also
-    those named without a process id, by older versions); the paths removed."""
+def remove_dead_temps(folder: Path, *, old_names: bool, prefix: str = TMP_PREFIX
+                      ) -> list[Path]:
+    """Remove the temporary files (names starting with ``prefix``) of processes that no
+    longer exist (``old_names``: also those named without a process id, by older versions);
+    the paths removed."""
     removed = []
-    for p in sorted(folder.glob(f"{TMP_PREFIX}*")):
-        owner = p.name[len(TMP_PREFIX):].split("-")[0]
+    for p in sorted(folder.glob(f"{prefix}*")):
+        owner = p.name[len(prefix):].split("-")[0]
         if owner.isdigit() and pid_alive(int(owner)):
             continue  # a live process's file (this process's too)
         if not owner.isdigit() and not old_names:

@@ -110,3 +110,14 @@ def test_overwrite_never_removes_a_stale_file_the_user_changed(tmp_path):
     with ResultFolder(tmp_path, overwrite=True) as out:
         out.add("c.txt", "C")
     assert sorted(p.name for p in tmp_path.iterdir()) == [MANIFEST, "c.txt"]
+
+
+def test_a_listed_name_that_is_now_a_folder_is_refused_untouched(tmp_path):
+    (tmp_path / "plots").mkdir()
+    (tmp_path / "plots" / "mine.png").write_bytes(b"png")
+    (tmp_path / MANIFEST).write_text(json.dumps(["plots"]))  # an older version's manifest
+    with pytest.raises(OverwriteRefused, match=r"plots \(changed since"), \
+            ResultFolder(tmp_path, overwrite=True) as out:
+        out.add("fit.json", "{}")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [MANIFEST, "plots"]
+    assert (tmp_path / "plots" / "mine.png").read_bytes() == b"png"

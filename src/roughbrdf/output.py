@@ -172,6 +172,11 @@ def _blocking_file(path: Path) -> Path | None:
     return None
 
 
+def _is_real_dir(path: Path) -> bool:
+    """Whether ``path`` is a folder itself (not a symbolic link to one)."""
+    return path.is_dir() and not path.is_symlink()
+
+
 def ensure_folder(path: str | os.PathLike) -> Path:
     """Create the folder ``path`` (and its parents) if needed; returns it.
 
@@ -454,8 +459,9 @@ class ResultFolder:
         here = {n for n in names | set(old) | self.adopt if os.path.lexists(self.path / n)}
         listed = {n for n in old if n in here}
         adopted = (self.adopt & here) - listed
-        changed = {n for n in listed
-                   if old[n] is not None and file_sha256(self.path / n) != old[n]}
+        # a folder now where roughbrdf wrote a file (an old manifest has no hash to tell)
+        changed = {n for n in listed if (old[n] is not None and file_sha256(self.path / n)
+                                         != old[n]) or _is_real_dir(self.path / n)}
         touched = (names & here) if self.extend else (names & here) | listed
         foreign = (names & here) - listed - adopted
         results = ((touched & listed) | (adopted & names)) - changed if self.extend \

@@ -20,9 +20,6 @@ from .common import (
 #: the library's argument names -> this verb's options (errors name the options)
 OPTIONS = EVAL_OPTIONS
 
-#: the polarization names ``--polarization`` takes (else an angle gamma in degrees)
-POLARIZATION_NAMES = ("unpolarized", "s", "p")
-
 #: the largest grid ``roughbrdf eval`` prints (theta_i x theta_r x phi values): each is a
 #: line of CSV
 MAX_EVAL_POINTS = 10 * MAX_RANGE_POINTS
@@ -51,18 +48,24 @@ def polarization_value(text: str) -> object:
     """
     import math
 
+    from ..fresnel import polarization_angle
+
     name = text.strip().lower()
-    if name in POLARIZATION_NAMES:
-        return name
     try:
         gamma = float(name)
     except ValueError:
+        pass
+    else:
+        if not math.isfinite(gamma):  # no direction of the field
+            raise ValueError(f"--polarization {text!r}: the angle gamma must be a finite "
+                             f"number of degrees")
+        return math.radians(gamma)
+    try:
+        polarization_angle(name)  # the library's names (also natural, perpendicular, te ...)
+    except ValueError:
         raise ValueError(f"--polarization {text!r}: expected unpolarized, s, p or an angle "
                          f"gamma in degrees from the plane of incidence") from None
-    if not math.isfinite(gamma):  # no direction of the field
-        raise ValueError(f"--polarization {text!r}: the angle gamma must be a finite number "
-                         f"of degrees")
-    return math.radians(gamma)
+    return name
 
 
 def register(app: typer.Typer) -> None:

@@ -68,14 +68,8 @@ def connect(client: Any = None, scheduler: str | None = None,
     # value"); the caller's environment is put back once the workers are up and at the end
     saved = {k: os.environ.get(k) for k in spawn}
     try:
-        mask = _block_sigint()  # see start_local; put back inside the try that closes it
+        cluster = start_local(n, spawn)
         try:
-            cluster = start_local(n, spawn)
-        except BaseException:
-            _unblock(mask)
-            raise
-        try:
-            _unblock(mask)  # a Ctrl-C of the start-up is raised here: the cluster is closed
             _restore_environ(saved)
             _call(STARTED_HOOKS, cluster)
             with Client(cluster, security=cluster.security) as c:
@@ -97,12 +91,10 @@ def start_local(n: int, spawn: dict[str, str]) -> Any:
     * no HTTP server (:class:`~roughbrdf.catalogue.worker.QuietScheduler`), so no port 8787
       and no warning when it is taken;
     * the workers' statistical profiler off (its call stacks grow the workers' memory);
-    * SIGINT blocked in the worker processes from their first instruction, when the caller
-      blocks it in this thread during the call (:func:`connect` does): Ctrl-C in a terminal
-      reaches the whole process group, and a worker still starting would print its
-      traceback. The mask is inherited by the threads the cluster starts (its event loop, the
-      nannies' process threads) and by the processes they spawn; :func:`connect` puts its
-      own mask back once the cluster is up, so a Ctrl-C of the start-up is seen then.
+    * SIGINT ignored in the worker processes as soon as they load their worker class
+      (:data:`~roughbrdf.catalogue.worker.WORKER_ENV` marks them): Ctrl-C in a terminal
+      reaches the whole process group, and a worker would print its traceback; the client
+      cancels the tasks and closes the cluster instead.
     """
     import logging
 
@@ -128,23 +120,6 @@ def start_local(n: int, spawn: dict[str, str]) -> Any:
     with dask.config.set(config):
         return SpecCluster(scheduler=scheduler, workers={i: worker for i in range(n)},
                            worker=worker, security=security, silence_logs=logging.ERROR)
-
-
-def _block_sigint() -> Any:
-    """Block SIGINT in this thread; the previous mask (None where signal masks do not exist)."""
-    import signal
-
-    if not hasattr(signal, "pthread_sigmask"):  # Windows: no signal masks (and no SIGINT to
-        return None                             # the process group either)
-    return signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-
-
-def _unblock(mask: Any) -> None:
-    """Put back the signal mask that :func:`_block_sigint` returned."""
-    import signal
-
-    if mask is not None:
-        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
 
 
 def _call(hooks: list[Callable[[Any], None]], arg: Any) -> None:

@@ -24,10 +24,23 @@ __all__ = ["WorkerSetup", "WORKER_ENV", "warm", "QuietScheduler", "QuietWorker",
 
 #: environment of the LocalCluster's worker processes: one thread in every thread pool, the
 #: workers' statistical profiler off (it keeps the call stacks of every task: with matplotlib's
-#: deep stacks about 3.5 MB more per plotted file), distributed's log lines only for errors
+#: deep stacks about 3.5 MB more per plotted file), distributed's log lines off (a task's
+#: error comes back with its future; the rest is the shutdown noise of a Ctrl-C)
 WORKER_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
-              "NUMBA_NUM_THREADS": "1", "DASK_LOGGING__DISTRIBUTED": "error",
-              "DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED": "False"}
+              "NUMBA_NUM_THREADS": "1", "DASK_LOGGING__DISTRIBUTED": "critical",
+              "DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED": "False",
+              "ROUGHBRDF_CATALOGUE_WORKER": "1"}
+
+
+def _ignore_sigint_if_worker() -> None:
+    """In a worker process of our local cluster (marked by :data:`WORKER_ENV`, which the
+    nannies set only while they spawn one), ignore SIGINT from now on: this module is loaded
+    when the process unpickles its :class:`QuietWorker` class, before ``distributed`` installs
+    the handler that turns Ctrl-C into a traceback; the parent closes the cluster on Ctrl-C."""
+    import os
+
+    if os.environ.get("ROUGHBRDF_CATALOGUE_WORKER") == "1":
+        _ignore_sigint()
 
 
 class QuietScheduler(Scheduler):
@@ -106,3 +119,6 @@ def _ignore_sigint() -> None:
             signal.signal(signal.SIGINT, signal.SIG_IGN)
         except (ValueError, OSError):
             pass
+
+
+_ignore_sigint_if_worker()

@@ -80,6 +80,15 @@ def test_eval_grid_limit(capsys):
     assert code == 2 and "--theta-i x --theta-r x --phi" in line and "1000000" in line
 
 
+@pytest.mark.parametrize("value", ["nan", "inf", "-5", "1e9"])
+def test_plot_elevation_in_degrees(capsys, tmp_path, value):
+    code, err = _run(capsys, "plot", "tr75", "--kind", "polar", "--theta-i", "30",
+                     "--elevation", value, "--out", tmp_path / "p.png")
+    line = _one_line(err)
+    assert code == 2 and "--elevation" in line and "degrees" in line and " rad" not in line
+    assert not (tmp_path / "p.png").exists()
+
+
 def test_param_without_equals_is_one_line(capsys):
     code, err = _run(capsys, "eval", "tr75", "-p", "e0.5")
     line = _one_line(err)
@@ -119,6 +128,12 @@ def test_folder_given_to_compare(capsys, tmp_path):
     code, err = _run(capsys, "compare", tmp_path, "--models", "tr75")
     line = _one_line(err)
     assert code == 2 and "folder" in line and "format=" not in line
+
+
+def test_folder_given_to_convert(capsys, tmp_path):
+    code, err = _run(capsys, "convert", tmp_path, tmp_path / "out.csv")
+    line = _one_line(err)
+    assert code == 2 and "is a folder" in line and "(none)" not in line
 
 
 def test_unknown_extension_names_format_option_of_fit(capsys, tmp_path):

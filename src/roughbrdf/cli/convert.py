@@ -101,6 +101,8 @@ def _check_paths(src: Path, dst: Path, force: bool) -> None:
 
     if not src.exists():
         raise FileNotFoundError(f"{src}: no such file")
+    if src.is_dir():  # not a file of an unknown extension
+        raise ValueError(f"IN {src} is a folder; convert reads one measurement file")
     if same_file(src, dst) or src.resolve() == dst.resolve():
         raise ValueError(f"IN and OUT are the same file ({dst}); convert never writes onto "
                          "its input, even with --force")

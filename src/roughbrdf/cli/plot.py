@@ -69,6 +69,9 @@ def _model_figure(model_name: str, params: dict[str, Any], kind: str, theta_i: s
     if ti.size != 1:
         raise ValueError(f"--kind {kind} takes one --theta-i, got {ti.size}")
     if kind == "polar":
+        if not (math.isfinite(elevation) and 0 <= elevation <= 90):  # else worded in radians
+            raise ValueError(f"--elevation {elevation!r}: must be a reflection elevation in "
+                             f"degrees, 0 <= DEG <= 90")
         return rbplot.plot_polar(m, float(ti[0]), math.radians(elevation), label=m.name)
     return rbplot.plot_hemisphere(m, float(ti[0]), quantity=quantity,
                                   log=True if log is None else log)

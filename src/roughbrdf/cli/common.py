@@ -9,6 +9,13 @@ stderr and the exit status of :mod:`roughbrdf.cli` (2 usage or input, 3 operatin
 bug, 130 interrupted), names CLI options in library errors about arguments
 (:class:`roughbrdf.errors.ArgumentError`, :class:`roughbrdf.output.OverwriteRefused`) and shows
 the traceback only with ``roughbrdf --debug``.
+
+Each verb has its table of options here (:data:`FIT_OPTIONS`, :data:`CONVERT_OPTIONS`, ...):
+library messages in Python terms (``starts must be >= 1``, ``pass format=``, ``angles='deg'``)
+are worded with the options of the verb that was run (:func:`argument_text`, :func:`cli_text`).
+Angles are degrees at this edge: the ranges of :func:`degree_range` (at most
+:data:`MAX_RANGE_POINTS` values) and the model parameters whose unit is an angle
+(:func:`cli_model`, :func:`cli_parameter_lines`).
 """
 
 from __future__ import annotations

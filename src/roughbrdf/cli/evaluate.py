@@ -83,7 +83,8 @@ def register(app: typer.Typer) -> None:
     def eval_cmd(
         model: Annotated[str, typer.Argument(help="model name, e.g. trowbridge-reitz-1975")],
         param: Annotated[list[str] | None, typer.Option(
-            "-p", "--param", help="name=value (repeatable)")] = None,
+            "-p", "--param",
+            help="name=value (repeatable; angles such as sigma in degrees)")] = None,
         theta_i: Annotated[str, typer.Option(
             "--theta-i", help="incidence zenith, DEG or START:STOP:STEP")] = "0",
         theta_r: Annotated[str, typer.Option(

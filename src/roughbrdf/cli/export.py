@@ -92,7 +92,8 @@ def register(app: typer.Typer) -> None:
         out: str = typer.Option(..., "--out", "-o", help="the file (Zemax: one per channel "
                                                           "of a fit, <stem>_<channel>.bsdf)"),
         param: Annotated[list[str] | None, typer.Option(
-            "-p", "--param", help="a MODEL's parameter or option, name=value (repeatable)")] = None,
+            "-p", "--param", help="a MODEL's parameter or option, name=value (repeatable; "
+                                  "angles such as sigma in degrees)")] = None,
         fit_dir: str = typer.Option(None, "--fit", metavar="DIR",
                                     help="export the fitted models of a saved fit (fit.json)"),
         channel: str = typer.Option(None, "--channel", "-c",

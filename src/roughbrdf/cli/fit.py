@@ -23,6 +23,10 @@ once with the roughness and index shared (``--shared NAME`` chooses), ``--keep-e
 also fits the values a file holds beyond the instrument's range (``rb.fit(...,
 extrapolated="keep")``).
 
+A parameter whose unit is an angle (Oren-Nayar ``sigma``, also in ``coated(diffuse=
+oren-nayar)`` and in sums) is in degrees in ``-p`` and ``--bounds`` and in the report printed
+and written to ``report.txt``; ``fit.json`` holds radians, as the library does.
+
 Exit status 1 when the fit did not converge for some channel (the results are written).
 """
 
@@ -67,13 +71,14 @@ KeepExtrapolatedOption = Annotated[bool, typer.Option(
 
 
 ParamOption = Annotated[list[str] | None, typer.Option(
-    "-p", "--param", help="starting value or option, name=value (repeatable)")]
+    "-p", "--param", help="starting value or option, name=value (repeatable; angles such as "
+                         "Oren-Nayar sigma in degrees)")]
 FixOption = Annotated[list[str] | None, typer.Option(
     "--fix", help="keep this parameter at its value (repeatable)")]
 BoundsOption = Annotated[list[str] | None, typer.Option(
     "--bounds", metavar="NAME=LOW:HIGH",
-    help="search range of a parameter, e.g. e=0.1:2 (repeatable; names as for --fix; a "
-         "default starting value outside it starts in the middle)")]
+    help="search range of a parameter, e.g. e=0.1:2 (repeatable; names as for --fix; angles "
+         "such as sigma in degrees; a default starting value outside it starts in the middle)")]
 ChannelOption = Annotated[list[str] | None, typer.Option(
     "--channel", "-c", help="channel label or index (repeatable; default: all)")]
 LossOption = Annotated[str, typer.Option(help="relative ((x-f)/f, TR75), log or absolute")]

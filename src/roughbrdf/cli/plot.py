@@ -228,7 +228,8 @@ def register(app: typer.Typer) -> None:
         model: Annotated[str | None, typer.Argument(
             help="model name, e.g. trowbridge-reitz-1975")] = None,
         param: Annotated[list[str] | None, typer.Option(
-            "-p", "--param", help="name=value (repeatable)")] = None,
+            "-p", "--param",
+            help="name=value (repeatable; angles such as sigma in degrees)")] = None,
         kind: Annotated[str, typer.Option(
             help="in-plane, polar, hemisphere; mueller (16 elements over the hemisphere), "
                  "mueller-plane (in the plane of incidence) or dolp")] = "in-plane",

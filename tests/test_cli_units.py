@@ -131,3 +131,13 @@ def test_python_report_keeps_radians_with_unit(tmp_path):
     assert float(line.split(":")[1].split()[0]) == pytest.approx(sigma, rel=1e-4)
     assert " rad" in line and "deg" not in line
     assert "deg" in _sigma_line(res.report(angles="deg"))
+
+
+def test_fit_bounds_of_sigma_refused_in_degrees(capsys, tmp_path):
+    path, _ = _oren_nayar_file(tmp_path)
+    code = main(["fit", str(path), "-m", "oren-nayar", "--bounds", "sigma=-10:20", "--out",
+                 str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1, err
+    assert "--bounds sigma=-10:20" in err and "[0, inf) degrees" in err
+    assert not (tmp_path / "o").exists()

@@ -155,9 +155,24 @@ def parse_bounds(model: Model, items: list[str] | None) -> dict[str, tuple[float
         if not (math.isfinite(low) and math.isfinite(high) and low < high):
             raise ValueError(f"--bounds {item}: need finite LOW < HIGH")
         (key,) = resolve_names(model, [name.strip()])
-        out[key] = ((math.radians(low), math.radians(high)) if key in angle_names(model)
-                    else (low, high))
+        out[key] = (low, high)
+        if key in angle_names(model):
+            out[key] = (math.radians(low), math.radians(high))
+            _check_angle_domain(model, key, item, *out[key])
     return out
+
+
+def _check_angle_domain(model: Model, key: str, item: str, low: float, high: float) -> None:
+    """Refuse ``--bounds`` of an angle parameter outside its physical domain, in degrees (the
+    library's own check would word it in radians)."""
+    spec = next(p for p in model.parameters if p.name == key)
+    dlo, lo_inc, dhi, hi_inc = spec.domain
+    if (low >= dlo if lo_inc else low > dlo) and (high <= dhi if hi_inc else high < dhi):
+        return
+    domain = (("[" if lo_inc else "(") + f"{math.degrees(dlo):g}, {math.degrees(dhi):g}"
+              + ("]" if hi_inc else ")"))
+    raise ValueError(f"--bounds {item}: the range leaves the physical domain of {key!r}, "
+                     f"{domain} degrees")
 
 
 def start_within(model: Model, ranges: dict[str, tuple[float, float]],

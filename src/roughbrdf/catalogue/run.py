@@ -1,7 +1,8 @@
 """Running catalogue tasks on ``dask.distributed``: the cluster, the loop, progress and limits.
 
 :func:`run_tasks` connects to the cluster (a ``Client`` given, a scheduler address, or a new
-``LocalCluster`` of single-threaded worker processes), registers
+local cluster of single-threaded worker processes, :func:`start_local`: TLS with temporary
+credentials, no HTTP server, the workers' profiler off), registers
 :class:`~roughbrdf.catalogue.worker.WorkerSetup`, and keeps at most one task per worker thread
 in flight, so that a task's start is known (its per-task time limit counts from there). A task
 whose worker died is run again up to ``retries`` times; a task over the time limit is reported

@@ -239,13 +239,11 @@ def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model
     label = _label(model)
     tasks, kept = [], {}
     summary = _summary_module()
-    with ResultFolder(out, overwrite=overwrite or resume) as cat:
-        cat.check(CATALOGUE_FILES)
-        if summary is not None and not (overwrite or resume):
-            from ..output import refuse_existing
-
-            for name in SUMMARY_FILES:
-                refuse_existing(out / name, False)
+    own = (*CATALOGUE_FILES, *(SUMMARY_FILES if summary is not None else ()))
+    # the catalogue files and the summary pages are one set (adopt: pages an older version
+    # wrote outside the set may be replaced with --force/--resume)
+    with ResultFolder(out, overwrite=overwrite or resume, adopt=SUMMARY_FILES) as cat:
+        cat.check(own)
         for i, (f, name) in enumerate(zip(files, folder_names(files), strict=True)):
             folder = out / name
             rows = completed_rows(folder, file_sha256(f), fp) if resume else None
@@ -267,11 +265,9 @@ def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model
 
         cat.add("catalogue.csv", csv_text(rows))
         cat.add("catalogue.json", json_text(rows, model=label))
-    written = [out / n for n in CATALOGUE_FILES]
-    if summary is not None:
-        written += [Path(p) for p in summary.write_summary(out, rows,
-                                                           overwrite=overwrite or resume)]
-    return CatalogueResult(rows=rows, out_dir=out, written=written)
+        if summary is not None:
+            summary.write_summary(out, rows, overwrite=overwrite or resume, into=cat)
+    return CatalogueResult(rows=rows, out_dir=out, written=[out / n for n in own])
 
 
 def check_options(model: Any, fit_options: Mapping[str, Any], *,

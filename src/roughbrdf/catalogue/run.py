@@ -258,20 +258,15 @@ def _workers_of(client: Any, futures: list[Any]) -> set[str]:
 
 
 def tidy(folder: str | os.PathLike) -> None:
-    """Remove the temporary files and the lock that a killed task left in its fit folder
-    (only when no live process on this machine holds the folder's lock:
-    :func:`roughbrdf.output.lock_is_stale`)."""
-    from ..output import LOCK, TMP_PREFIX, lock_is_stale
+    """Repair what a killed task left in its fit folder (a worker killed by ``--time-limit``
+    or by the operating system): :func:`roughbrdf.output.recover` rolls a half-done commit
+    forward or back and removes the temporary files and the lock of processes that no longer
+    exist (never a live process's); an empty folder the task had just created goes too."""
+    from ..output import recover
 
     path = Path(folder)
-    lock = path / LOCK
-    if not lock_is_stale(lock):
-        return
-    for p in path.glob(f"{TMP_PREFIX}*") if path.is_dir() else []:
-        with contextlib.suppress(OSError):
-            p.unlink()
-    with contextlib.suppress(OSError):
-        lock.unlink()
+    with contextlib.suppress(OSError):  # a crafted manifest (ManifestRefused) is left as it is
+        recover(path)
     with contextlib.suppress(OSError):
         path.rmdir()  # only if empty: a folder the task had just created
 

@@ -227,3 +227,37 @@ def test_help_loads_neither_dask_nor_numpy():
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           check=True)
     assert proc.stdout.strip().splitlines()[-1] == "[]"
+
+
+def _dead_pid() -> int:
+    """The process id of a process that has ended (a killed worker's, for the clean-up)."""
+    proc = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)
+    return int(proc.stdout)
+
+
+def test_resume_cleans_what_killed_workers_left(files, cluster, tmp_path):
+    # a worker killed mid-save (--time-limit restart, OOM kill) leaves its temporary files and
+    # its lock in the fit folder; --resume removes them, in skipped folders and re-fitted ones
+    from roughbrdf.catalogue.resume import TASK_FILE
+    from roughbrdf.output import LOCK, TMP_PREFIX
+
+    out = tmp_path / "cat"
+    first = fit_catalogue(files[:2], "tr75", out, scheduler=cluster.scheduler_address,
+                          plots=False, progress=False, **OPTS)
+    folders = sorted({r["fit_dir"] for r in first.rows})
+    assert len(folders) == 2
+    pid = _dead_pid()
+    for name in folders:
+        (out / name / f"{TMP_PREFIX}{pid}-fit.json.part").write_text("half")
+        (out / name / LOCK).write_text(f"{pid}\n")
+    (out / folders[1] / TASK_FILE).unlink()  # an incomplete result: fitted again
+    res = fit_catalogue(files[:2], "tr75", out, scheduler=cluster.scheduler_address,
+                        plots=False, progress=False, resume=True, **OPTS)
+    assert [r["status"] for r in res.rows if r["fit_dir"] == folders[0]][0].startswith(
+        "skipped")
+    assert not [r for r in res.rows if r["file"].endswith("s1.csv")][0]["status"].startswith(
+        "skipped")
+    for name in folders:
+        left = sorted(p.name for p in (out / name).iterdir() if p.name.startswith("."))
+        assert left == [".roughbrdf-outputs"], (name, left)

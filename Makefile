@@ -40,8 +40,9 @@ browser:
 test: $(STAMP) browser
 	$(PY) -m pytest -q -p no:cacheprovider
 
+# BENCH_ARGS: e.g. --skip-worker-memory (the slow worker-memory figure), or benchmark names
 bench: $(STAMP)
-	$(PY) benchmarks/run.py
+	$(PY) benchmarks/run.py $(BENCH_ARGS)
 
 lint: $(STAMP)
 	$(PY) -m ruff check src tests benchmarks

@@ -2,47 +2,17 @@
 
 from __future__ import annotations
 
-import inspect
 import math
-import sys
 
 import numpy as np
 import pytest
+from spies import python_calls_parsing_rows
 
 import roughbrdf as rb
 from roughbrdf.io import FormatError, alta
 from roughbrdf.measurement import Measurement
 
-#: code flags of a generator or coroutine (a resumption is a 'call' to the profiler)
-_GENERATOR = inspect.CO_GENERATOR | inspect.CO_COROUTINE | inspect.CO_ASYNC_GENERATOR
-
 HEAD = "#DIM 3 1\n#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI\n#PARAM_OUT INV_STERADIAN\n"
-
-
-def _python_calls_parsing_rows(monkeypatch, module) -> list[tuple[int, int]]:
-    """Spy on ``module.parse_rows``: for each call, (rows given, Python function calls made
-    inside it, generators' resumptions aside). The rows of a file are parsed as one block when
-    that count does not grow with the rows (the row-by-row parse makes several per row)."""
-    real = module.parse_rows
-    seen: list[tuple[int, int]] = []
-
-    def spy(texts, *args, **kwargs):
-        calls = [0]
-
-        def profile(frame, event, arg):
-            if event == "call" and not frame.f_code.co_flags & _GENERATOR:
-                calls[0] += 1
-
-        previous = sys.getprofile()
-        sys.setprofile(profile)
-        try:
-            return real(texts, *args, **kwargs)
-        finally:
-            sys.setprofile(previous)
-            seen.append((len(texts), calls[0]))
-
-    monkeypatch.setattr(module, "parse_rows", spy)
-    return seen
 
 
 def _write(tmp_path, rows, head=HEAD, name="a.dat"):
@@ -70,7 +40,7 @@ def test_missing_param_out_asks_for_quantity(shared_data):
 def test_gray_tape_retro_peak_at_retro_direction(shared_data, monkeypatch):
     """ALTA's dphi = 0 is the source side: the retro peak must land at theta_r = theta_i,
     phi = pi. data/README.md gives the peak heights 72.5, 42.5, 1.13 (BRDF x cos)."""
-    parsed = _python_calls_parsing_rows(monkeypatch, alta)
+    parsed = python_calls_parsing_rows(monkeypatch, alta)
     m = rb.read(shared_data / "cea_retro" / "retro-gray-tape.dat", quantity="brdf_cos")
     # the rows are parsed in one block, in NumPy (the read's time: benchmarks/)
     (rows, calls), = parsed

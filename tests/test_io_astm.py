@@ -2,18 +2,14 @@
 
 from __future__ import annotations
 
-import inspect
 import math
-import sys
 
 import numpy as np
 import pytest
+from spies import python_calls_parsing_rows
 
 import roughbrdf as rb
 from roughbrdf.io import FormatError, astm
-
-#: code flags of a generator or coroutine (a resumption is a 'call' to the profiler)
-_GENERATOR = inspect.CO_GENERATOR | inspect.CO_COROUTINE | inspect.CO_ASYNC_GENERATOR
 
 HEADER = """LAB_NAME Test Lab
 
@@ -35,32 +31,6 @@ def _rows(deg: bool = False) -> list[str]:
     return rows
 
 
-def _python_calls_parsing_rows(monkeypatch, module) -> list[tuple[int, int]]:
-    """Spy on ``module.parse_rows``: for each call, (rows given, Python function calls made
-    inside it, generators' resumptions aside). The rows of a file are parsed as one block when
-    that count does not grow with the rows (the row-by-row parse makes several per row)."""
-    real = module.parse_rows
-    seen: list[tuple[int, int]] = []
-
-    def spy(texts, *args, **kwargs):
-        calls = [0]
-
-        def profile(frame, event, arg):
-            if event == "call" and not frame.f_code.co_flags & _GENERATOR:
-                calls[0] += 1
-
-        previous = sys.getprofile()
-        sys.setprofile(profile)
-        try:
-            return real(texts, *args, **kwargs)
-        finally:
-            sys.setprofile(previous)
-            seen.append((len(texts), calls[0]))
-
-    monkeypatch.setattr(module, "parse_rows", spy)
-    return seen
-
-
 def _write(tmp_path, rows, n=None, header=HEADER, name="s.astm"):
     p = tmp_path / name
     p.write_text(header.format(n=len(rows) if n is None else n) + "\n".join(rows) + "\n")
@@ -73,7 +43,7 @@ def _write(tmp_path, rows, n=None, header=HEADER, name="s.astm"):
 @pytest.mark.parametrize("name", ["C2_Black", "C8_Silver", "C12_OliveDrab"])
 def test_real_minidiff_files(shared_data, name, monkeypatch):
     path = shared_data / "minidiff" / f"{name}.astm"
-    parsed = _python_calls_parsing_rows(monkeypatch, astm)
+    parsed = python_calls_parsing_rows(monkeypatch, astm)
     m = rb.read(path)
     # the 12964 rows are parsed in one block, in NumPy (the read's time: benchmarks/)
     (rows, calls), = parsed

@@ -113,12 +113,6 @@ def canonical(code: int | Shadowing) -> str:
 # --------------------------------------------------------------------------------------------
 # scalar parts
 # --------------------------------------------------------------------------------------------
-@jit
-def _safe_div(a, b):
-    # used where the quotient is a candidate of a min(): a zero denominator means "no bound"
-    return a / b if b > 0.0 else math.inf
-
-
 @jit(inline=True)
 def v_groove_g(ci, cr, ch, cd):
     """Scalar TS67 V-groove G from cosines (closed form, docs/models.md §2.5)."""

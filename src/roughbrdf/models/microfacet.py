@@ -59,12 +59,6 @@ def _micro_eval(ti, tr, phi, gamma, p, flag, dcode, scode):
     return 0.25 * t * geo if t > 0.0 else 0.0
 
 
-@jit(inline=True)
-def _micro_point(ti, tr, phi, gamma, p, flag):
-    """The microfacet kernel at one sample, codes read from the packed parameters ``p``."""
-    return _micro_eval(ti, tr, phi, gamma, p, flag, int(p[4]), int(p[5]))
-
-
 @driver
 def _micro_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
     # module-level loop: cached on disk (roughbrdf._kernels.compile.driver). Specialized

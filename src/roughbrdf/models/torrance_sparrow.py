@@ -72,14 +72,6 @@ def _ts67_eval(ti, tr, phi, gamma, p, flag, use_f):
     return rho_d / math.pi * (facet + 1.0)
 
 
-@jit(inline=True)
-def _ts67_point(ti, tr, phi, gamma, p, flag):
-    """The TS67 kernel at one sample (``p[5] > 0``: with Fresnel, else F = 1)."""
-    if p[5] > 0.0:
-        return _ts67_eval(ti, tr, phi, gamma, p, flag, True)
-    return _ts67_eval(ti, tr, phi, gamma, p, flag, False)
-
-
 @driver
 def _ts67_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
     # module-level loop: cached on disk (roughbrdf._kernels.compile.driver). One loop per

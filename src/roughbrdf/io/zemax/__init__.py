@@ -101,11 +101,11 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ArgumentError
-from ..measurement import Measurement
-from ..output import staged
-from ..quantity import Quantity
-from ._common import (
+from ...errors import ArgumentError
+from ...measurement import Measurement
+from ...output import staged
+from ...quantity import Quantity
+from .._common import (
     LAYOUT,
     FormatError,
     describe_keys,
@@ -114,7 +114,7 @@ from ._common import (
     unit_word,
     warn_not_written,
 )
-from ._rows import begin_read, parse_number, parse_rows
+from .._rows import begin_read, parse_number, parse_rows
 
 __all__ = ["read", "write", "read_table", "write_table", "table_integral", "plan",
            "specular_to_common", "common_to_specular", "grid_from_radians",

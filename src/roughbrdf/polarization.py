@@ -15,11 +15,12 @@ array: ``stokes``, the incident Stokes vector ``[I, Q, U, V]`` (shape ``(..., 4)
 sample allowed), and ``analyzer``, the detector's row vector ``a`` (shape ``(..., 4)``; None:
 the total reflected intensity). With either set the model is evaluated through its Mueller
 matrix (:meth:`roughbrdf.models.Model.mueller`, in ``basis``) as ``a . (M S)``
-(:func:`evaluate_stokes`); ``gamma`` (NaN: unpolarized) gives ``S`` when ``stokes`` is not
-set. The ``s``, ``p``, ``gamma`` and unpolarized evaluations without an analyzer stay on the
-scalar kernels, unchanged. Stokes vectors, angles and handedness follow the conventions of
-:mod:`roughbrdf.mueller`; :mod:`roughbrdf.stokes` builds the vectors (``stokes.linear(gamma)``,
-``stokes.circular(...)``, ``stokes.analyzer_row(...)``).
+(:func:`roughbrdf.models.polarimetry.evaluate_stokes`); ``gamma`` (NaN: unpolarized) gives
+``S`` when ``stokes`` is not set. The ``s``, ``p``, ``gamma`` and unpolarized evaluations
+without an analyzer stay on the scalar kernels, unchanged. Stokes vectors, angles and
+handedness follow the conventions of :mod:`roughbrdf.mueller`; :mod:`roughbrdf.stokes` builds
+the vectors (``stokes.linear(gamma)``, ``stokes.circular(...)``, ``stokes.analyzer_row(...)``)
+and checks them (:func:`roughbrdf.stokes.as_stokes`).
 
 Examples
 --------
@@ -43,15 +44,12 @@ import numpy as np
 
 from .errors import ArgumentError
 from .fresnel import polarization_angle
-from .quantity import Quantity
 
-__all__ = ["Polarization", "BASES", "evaluate_stokes"]
+# the vectors and their check live in roughbrdf.stokes; BASES and PHYSICAL_RTOL stay
+# importable from here, where they were first defined
+from .stokes import BASES, PHYSICAL_RTOL, as_stokes, linear, unpolarized  # noqa: F401
 
-#: the polarization bases of :meth:`roughbrdf.models.Model.mueller` (:mod:`roughbrdf.mueller`)
-BASES = ("psps", "xyxy")
-#: relative slack of the physical-state check ``S0 >= |(S1, S2, S3)|``: a vector built from
-#: cosines and sines (``[1, cos 2g, sin 2g, 0]``) may exceed it by a rounding error
-PHYSICAL_RTOL = 1e-9
+__all__ = ["Polarization", "BASES"]
 
 
 @dataclass(frozen=True)
@@ -88,12 +86,12 @@ class Polarization:
 
     def __post_init__(self) -> None:
         if self.stokes is not None:
-            object.__setattr__(self, "stokes", _stokes_array(self.stokes, "stokes"))
+            object.__setattr__(self, "stokes", as_stokes(self.stokes, "stokes"))
             if not np.isnan(np.asarray(self.gamma, dtype=float)).all():
                 raise ArgumentError("stokes", "give the incident polarization once: either "
                                     "an angle gamma or a Stokes vector", value=self.gamma)
         if self.analyzer is not None:
-            object.__setattr__(self, "analyzer", _stokes_array(self.analyzer, "analyzer"))
+            object.__setattr__(self, "analyzer", as_stokes(self.analyzer, "analyzer"))
         if self.basis not in BASES:
             raise ArgumentError("basis", f"must be one of {', '.join(BASES)}",
                                 value=self.basis)
@@ -111,7 +109,7 @@ class Polarization:
     @property
     def is_polarimetric(self) -> bool:
         """Whether a Stokes vector or an analyzer is set (evaluation through the Mueller
-        matrix, :func:`evaluate_stokes`)."""
+        matrix, :func:`roughbrdf.models.polarimetry.evaluate_stokes`)."""
         return self.stokes is not None or self.analyzer is not None
 
     def incident_stokes(self) -> np.ndarray:
@@ -119,8 +117,6 @@ class Polarization:
         ``gamma`` (:func:`roughbrdf.stokes.linear`; unpolarized ``[1, 0, 0, 0]`` where NaN)."""
         if self.stokes is not None:
             return self.stokes
-        from .stokes import linear, unpolarized
-
         gam = np.asarray(self.gamma, dtype=float)
         nan = np.isnan(gam)[..., None]
         return np.where(nan, unpolarized(), linear(np.where(nan[..., 0], 0.0, gam)))
@@ -180,79 +176,6 @@ class Polarization:
         if self.stokes is not None:
             return bool((self.stokes[..., 1:] == 0).all())
         return bool(np.isnan(self.gamma).all())
-
-
-def _stokes_array(value: Any, argument: str) -> np.ndarray:
-    """``value`` as a float array of shape ``(..., 4)``: finite real numbers, each vector a
-    physical state ``v0 >= |(v1, v2, v3)|``; ArgumentError naming ``argument`` otherwise."""
-    shown = repr(value) if len(repr(value)) <= 80 else repr(value)[:70] + " ..."
-    try:
-        arr = np.asarray(value)
-    except (TypeError, ValueError, OverflowError):
-        raise ArgumentError(argument, f"must be an array of 4 real numbers per vector, got "
-                            f"{shown}") from None
-    if arr.dtype.kind not in "biuf" or arr.ndim == 0 or arr.shape[-1] != 4:
-        raise ArgumentError(argument, "must be an array of shape (..., 4) of real numbers "
-                            f"[I, Q, U, V], got {shown}")
-    arr = np.array(arr, dtype=np.float64)  # a copy: the caller's array may change later
-    if not np.isfinite(arr).all():
-        raise ArgumentError(argument, f"must be finite, got {shown}")
-    pol = np.sqrt(np.sum(arr[..., 1:] ** 2, axis=-1))
-    bad = pol > arr[..., 0] * (1.0 + PHYSICAL_RTOL)  # also v0 < 0, and v0 = 0 with v != 0
-    if bad.any():
-        first = arr[np.nonzero(bad)][0].tolist() if arr.ndim > 1 else arr.tolist()
-        what = ("no physical light has it: I >= |(Q, U, V)| is needed" if argument == "stokes"
-                else "a detector with it would read a negative signal for some light: "
-                "a0 >= |(a1, a2, a3)| is needed")
-        raise ArgumentError(argument, what, value=first)
-    return arr
-
-
-def evaluate_stokes(model: Any, theta_i: Any, theta_r: Any, phi: Any,
-                    polarization: Polarization, *, quantity: Quantity | str = "brdf",
-                    term: str | None = None) -> np.ndarray | float:
-    """``a . (M S)``: the analyzer-weighted reflected value for an incident Stokes vector.
-
-    ``M`` is ``model.mueller(theta_i, theta_r, phi, basis=polarization.basis, term=term)``
-    (sr⁻¹), ``S`` :meth:`Polarization.incident_stokes` and ``a`` the analyzer (None: the total
-    intensity ``(M S)[0]``). ``quantity`` as in :meth:`roughbrdf.models.Model.evaluate`:
-    ``brdf``, ``brdf_cos``/``bridf`` (times ``cos theta_r``) or ``relative`` (divided by the
-    same at the specular direction). This is what ``Model.evaluate`` runs when the
-    polarization :attr:`~Polarization.is_polarimetric`.
-
-    Returns
-    -------
-    numpy.ndarray or float
-        The broadcast shape of the angles and the leading axes of ``stokes`` and
-        ``analyzer``; a float when that is ``()``.
-    """
-    q = Quantity.parse(quantity)
-    value = _detected(model, theta_i, theta_r, phi, polarization, term)
-    if q is Quantity.RELATIVE:
-        ti = np.asarray(theta_i, dtype=float)
-        value = value / _detected(model, ti, ti, np.zeros_like(ti), polarization, term)
-    elif q.cosine_weighted:
-        value = value * np.cos(np.asarray(theta_r, dtype=float))
-    return float(value) if np.ndim(value) == 0 else value
-
-
-def _detected(model: Any, theta_i: Any, theta_r: Any, phi: Any, pol: Polarization,
-              term: str | None) -> np.ndarray:
-    """``a . (M S)`` (or ``(M S)[0]``), broadcast over the angles, ``stokes`` and
-    ``analyzer``."""
-    mat = np.asarray(model.mueller(theta_i, theta_r, phi, basis=pol.basis, term=term),
-                     dtype=float)
-    s_in = pol.incident_stokes()
-    shapes = {"angles": mat.shape[:-2], "stokes": s_in.shape[:-1]}
-    if pol.analyzer is not None:
-        shapes["analyzer"] = pol.analyzer.shape[:-1]
-    from .geometry import check_broadcast
-
-    check_broadcast(**{k: np.broadcast_to(0.0, v) for k, v in shapes.items()})
-    out = np.matmul(mat, s_in[..., None])[..., 0]
-    if pol.analyzer is None:
-        return out[..., 0]
-    return np.sum(pol.analyzer * out, axis=-1)
 
 
 def _bad(value: Any) -> ArgumentError:

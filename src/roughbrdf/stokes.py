@@ -27,6 +27,12 @@ the library frame (``docs/models.md`` §1.1) for the ``psps`` and ``xyxy`` bases
 and a polarimeter's own frame, given by its **reference axis** (the lab direction of its
 ``Q > 0`` axis, e.g. the goniometer's vertical) and handedness; :func:`change_basis` converts
 between ``psps`` and ``xyxy``; :func:`mueller_from_frames` converts a whole Mueller matrix.
+
+Checked arrays
+--------------
+:func:`as_stokes` is the one check of a Stokes vector or an analyzer row given by a user (shape
+``(..., 4)``, finite real numbers, a physical state): :class:`roughbrdf.polarization.Polarization`
+and :func:`reflected_stokes` use it, and :data:`BASES` names the polarization bases.
 """
 
 from __future__ import annotations
@@ -38,17 +44,65 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .errors import ArgumentError
-from .polarization import BASES, _stokes_array
 
-__all__ = ["linear", "s", "p", "unpolarized", "circular", "analyzer_row", "reflected_stokes",
-           "dolp", "aolp", "docp", "dop", "rotate_stokes", "rotation_matrix", "basis_vectors",
-           "reference_angle", "from_frame", "to_frame", "change_basis", "mueller_from_frames"]
+__all__ = ["as_stokes", "linear", "s", "p", "unpolarized", "circular", "analyzer_row",
+           "reflected_stokes", "dolp", "aolp", "docp", "dop", "rotate_stokes", "rotation_matrix",
+           "basis_vectors", "reference_angle", "from_frame", "to_frame", "change_basis",
+           "mueller_from_frames"]
 
+#: the polarization bases of :meth:`roughbrdf.models.Model.mueller` (:mod:`roughbrdf.mueller`)
+BASES = ("psps", "xyxy")
+#: relative slack of the physical-state check ``S0 >= |(S1, S2, S3)|``: a vector built from
+#: cosines and sines (``[1, cos 2g, sin 2g, 0]``) may exceed it by a rounding error
+PHYSICAL_RTOL = 1e-9
 #: circular senses: V = +1 for the field turning counter-clockwise seen looking toward the
 #: source (``"ccw"``, SCATMECH's and Born & Wolf's ``"left"``), -1 for ``"cw"``/``"right"``
 _SENSES = {"ccw": 1.0, "left": 1.0, "cw": -1.0, "right": -1.0}
 #: a reference axis closer than this (sine of the angle) to the beam has no transverse part
 _PARALLEL = 1e-9
+
+
+# --------------------------------------------------------------------------------------------
+# checked arrays
+# --------------------------------------------------------------------------------------------
+def as_stokes(value: Any, argument: str) -> np.ndarray:
+    """``value`` as a float array of shape ``(..., 4)``: finite real numbers, each vector a
+    physical state ``v0 >= |(v1, v2, v3)|``; ArgumentError naming ``argument`` otherwise.
+
+    ``argument`` is the name the caller knows the value by (``"stokes"``, ``"analyzer"``,
+    ``"incident"``); for ``"stokes"`` a non-physical vector is "no physical light", for any
+    other name a detector row that "would read a negative signal". The result is a copy.
+
+    Examples
+    --------
+    >>> as_stokes([1, 0, 0, 1], "stokes").tolist()
+    [1.0, 0.0, 0.0, 1.0]
+    >>> as_stokes([1.0, 2.0, 0.0, 0.0], "stokes")
+    Traceback (most recent call last):
+    ...
+    roughbrdf.errors.ArgumentError: stokes = [1.0, 2.0, 0.0, 0.0]: no physical light has it: ...
+    """
+    shown = repr(value) if len(repr(value)) <= 80 else repr(value)[:70] + " ..."
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError, OverflowError):
+        raise ArgumentError(argument, f"must be an array of 4 real numbers per vector, got "
+                            f"{shown}") from None
+    if arr.dtype.kind not in "biuf" or arr.ndim == 0 or arr.shape[-1] != 4:
+        raise ArgumentError(argument, "must be an array of shape (..., 4) of real numbers "
+                            f"[I, Q, U, V], got {shown}")
+    arr = np.array(arr, dtype=np.float64)  # a copy: the caller's array may change later
+    if not np.isfinite(arr).all():
+        raise ArgumentError(argument, f"must be finite, got {shown}")
+    pol = np.sqrt(np.sum(arr[..., 1:] ** 2, axis=-1))
+    bad = pol > arr[..., 0] * (1.0 + PHYSICAL_RTOL)  # also v0 < 0, and v0 = 0 with v != 0
+    if bad.any():
+        first = arr[np.nonzero(bad)][0].tolist() if arr.ndim > 1 else arr.tolist()
+        what = ("no physical light has it: I >= |(Q, U, V)| is needed" if argument == "stokes"
+                else "a detector with it would read a negative signal for some light: "
+                "a0 >= |(a1, a2, a3)| is needed")
+        raise ArgumentError(argument, what, value=first)
+    return arr
 
 
 # --------------------------------------------------------------------------------------------
@@ -191,7 +245,7 @@ def reflected_stokes(model: Any, theta_i: ArrayLike, theta_r: ArrayLike, phi: Ar
     >>> bool(np.isclose(out[0], m.brdf(0.6, 0.6, 0.0, polarization=0.3), rtol=1e-12))
     True
     """
-    s_in = _stokes_array(incident, "incident")
+    s_in = as_stokes(incident, "incident")
     mat = np.asarray(model.mueller(theta_i, theta_r, phi, basis=basis, term=term), dtype=float)
     try:
         shape = np.broadcast_shapes(mat.shape[:-2], s_in.shape[:-1])

@@ -17,6 +17,10 @@ returning the BRDF (``flag = 0``) or ``f_r cos(theta_r)`` (``flag = 1``) for the
 parameter tuple ``p`` (``_pack``), and a module-level parallel loop over it (``_drive``, a
 :func:`roughbrdf._kernels.driver`); :func:`roughbrdf._kernels.evaluate` broadcasts NumPy inputs
 onto it.
+
+A polarimetric setting (an incident Stokes vector, an analyzer row) is evaluated through
+:meth:`Model.mueller` by :func:`roughbrdf.models.polarimetry.evaluate_stokes`, which
+:meth:`Model.evaluate` calls.
 """
 
 from __future__ import annotations
@@ -32,10 +36,11 @@ from numpy.typing import ArrayLike
 from .. import _kernels
 from ..errors import ArgumentError
 from ..geometry import check_angles, check_broadcast
-from ..polarization import Polarization, evaluate_stokes
+from ..polarization import Polarization
 from ..quantity import Quantity
 from ..registry import Registry, unknown_name
 from .parameters import Parameter, ReadOnlyDict
+from .polarimetry import evaluate_stokes
 
 __all__ = ["Model", "NoMuellerMatrix", "PreparedGeometry", "SumModel", "components", "MODELS",
            "register", "require_index"]

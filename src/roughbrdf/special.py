@@ -43,7 +43,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._kernels import as_float_array, jit, ufunc
-from ._kernels.vmath import _f2i, _i2f, vasin, vexp, vlog, vlog1p  # noqa: F401 - re-exported
+from ._kernels.vmath import vasin, vexp, vlog, vlog1p  # noqa: F401 - re-exported
 
 __all__ = ["gammaincc", "gammaincc_q", "gammaincc_int", "stirlerr", "bd0", "FINITE_SUM_MAX",
            "INT_HORNER_MAX", "vexp", "vlog", "vlog1p", "vasin"]

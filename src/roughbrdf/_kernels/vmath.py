@@ -38,7 +38,7 @@ Writing rules, followed by every function here:
   whose value is discarded: the plain-Python path (``NUMBA_DISABLE_JIT=1``) computes those
   lanes too and would raise ``ZeroDivisionError``/``ValueError``, and NumPy would report a 0/0
   in a ufunc as a RuntimeWarning;
-* bit manipulations use two bit-cast intrinsics (:func:`_f2i`, :func:`_i2f`), which are plain
+* bit manipulations use two bit-cast intrinsics (:func:`f2i`, :func:`i2f`), which are plain
   ``struct`` conversions under ``NUMBA_DISABLE_JIT=1``.
 """
 
@@ -55,25 +55,26 @@ from numba.extending import intrinsic
 from .compile import DISABLE_JIT, jit
 
 __all__ = ["TINY", "SINCOS_MAX_ARG", "sincos", "vexp", "vlog", "vlog1p", "vasin", "vacos",
-           "vatan2", "verfc"]
+           "vatan2", "verfc", "f2i", "i2f"]
 
 # --------------------------------------------------------------------------------------------
 # bit casts between float64 and int64
 # --------------------------------------------------------------------------------------------
 if DISABLE_JIT:
 
-    def _f2i(x):
+    def f2i(x):
         """Bits of a float64 as int64."""
         return struct.unpack("<q", struct.pack("<d", float(x)))[0]
 
-    def _i2f(i):
+    def i2f(i):
         """int64 bits as a float64."""
         return struct.unpack("<d", struct.pack("<q", int(i)))[0]
 
 else:
 
     @intrinsic
-    def _f2i(typingctx, x):  # pragma: no cover - compiled
+    def f2i(typingctx, x):  # pragma: no cover - compiled
+        """Bits of a float64 as int64 (an LLVM bitcast)."""
         if not isinstance(x, types.Float):
             return None
 
@@ -83,7 +84,8 @@ else:
         return types.int64(types.float64), codegen
 
     @intrinsic
-    def _i2f(typingctx, i):  # pragma: no cover - compiled
+    def i2f(typingctx, i):  # pragma: no cover - compiled
+        """int64 bits as a float64 (an LLVM bitcast)."""
         if not isinstance(i, types.Integer):
             return None
 
@@ -185,7 +187,7 @@ def vexp(x):
     ki = int(k)
     k1 = ki >> 1  # 2^k = 2^k1 2^k2, each a normal number for k in [-1076, 1024]
     k2 = ki - k1
-    res = y * _i2f((k1 + 1023) << 52) * _i2f((k2 + 1023) << 52)
+    res = y * i2f((k1 + 1023) << 52) * i2f((k2 + 1023) << 52)
     return math.nan if nan else res
 
 
@@ -208,7 +210,7 @@ def _vexp2(hi, lo):
     ki = int(k)
     k1 = ki >> 1  # as in vexp
     k2 = ki - k1
-    res = y * _i2f((k1 + 1023) << 52) * _i2f((k2 + 1023) << 52)
+    res = y * i2f((k1 + 1023) << 52) * i2f((k2 + 1023) << 52)
     return math.nan if nan else res
 
 
@@ -241,9 +243,9 @@ def vlog(x):
     xx = 1.0 if special_ else x  # a harmless stand-in on the special lanes (result replaced)
     sub = xx < _TINY_NORMAL
     xx = xx * 18014398509481984.0 if sub else xx  # 2^54: subnormals become normal
-    bits = _f2i(xx)
+    bits = f2i(xx)
     k = (bits >> 52) - 1023
-    m = _i2f((bits & _MANT_MASK) | _ONE_BITS)  # mantissa in [1, 2)
+    m = i2f((bits & _MANT_MASK) | _ONE_BITS)  # mantissa in [1, 2)
     big = m > _SQRT2
     m = 0.5 * m if big else m
     kf = float(k) + (1.0 if big else 0.0) - (54.0 if sub else 0.0)
@@ -351,7 +353,7 @@ def vacos(x):
     p = t * (_PS0 + t * (_PS1 + t * (_PS2 + t * (_PS3 + t * (_PS4 + t * _PS5)))))
     q = 1.0 + t * (_QS1 + t * (_QS2 + t * (_QS3 + t * _QS4)))  # in [0.6, 1] for t in [0, 1/4]
     # x >= 1/2: df = s with the low 32 bits cleared, so df * df and z - df * df are exact
-    df = _i2f(_f2i(s) & _HIGH_WORD)
+    df = i2f(f2i(s) & _HIGH_WORD)
     sdf = s + df
     num = p if lo else (p * s * sdf + (z - df * df) * q if pos else p * s)
     den = q if lo else (q * sdf if pos else q)
@@ -546,7 +548,7 @@ def verfc(x):
     # [0.84375, 1.25)
     r1 = (1.0 - _ERX) - y if xs >= 0.0 else 1.0 + (_ERX + y)
     # [1.25, 28): exp(-x^2 - 0.5625 + y)/|x|, -x^2 = -z^2 + (z - ax)(z + ax) exactly
-    z = _i2f(_f2i(ax) & _HIGH_WORD)  # z^2 exact (21-bit mantissa)
+    z = i2f(f2i(ax) & _HIGH_WORD)  # z^2 exact (21-bit mantissa)
     hi = -z * z - 0.5625
     lo = ((-z * z - hi) - 0.5625) + ((z - ax) * (z + ax) + y)  # Fast2Sum error, |z^2| > 0.5625
     tail = _vexp2(hi, lo) / (ax if i2 else 1.0)  # (ax >= 1.25 where it is used)

@@ -22,7 +22,14 @@ TS67        (psi, theta, phi)           :func:`from_ts67`, :func:`to_ts67` (same
 TR75        (beta, elevation, psi_TR)   :func:`from_tr75`, :func:`to_tr75` (psi_TR = pi - phi)
 RB08        (alpha, beta, alpha0)       :func:`from_rb08`, :func:`to_rb08` (direction cosines)
 MERL        (theta_h, theta_d, phi_d)   :func:`from_rusinkiewicz`, :func:`to_rusinkiewicz`
+Zemax       (radial, azimuth) about     :func:`specular_to_common`, :func:`common_to_specular`
+            the specular direction      (the tabular BSDF's frame, :mod:`roughbrdf.io.zemax`)
 ==========  ==========================  ======================================================
+
+Layout: this module holds the validation of angles, the compiled scalar parts and their NumPy
+front ends; the conversions between frames (the table above, with :func:`unit_vectors` and
+:func:`angles_from_vectors`) are in :mod:`roughbrdf.geometry_frames` (NumPy, not used inside
+kernels) and importable from here, which is where to import every name of the table from.
 
 The scalar functions (``half_vector``, ``ts67_projected``, ``tr75_eta_from_h``) are Numba
 parts used inside every model kernel; the ufuncs of the same names without the suffix are their
@@ -39,6 +46,22 @@ from numpy.typing import ArrayLike
 from ._kernels import SINCOS_MAX_ARG, TINY, jit, sincos, ufunc
 from ._kernels.vmath import vatan2
 from .errors import ArgumentError
+from .geometry_frames import (
+    angles_from_vectors,
+    common_to_specular,
+    from_rb08,
+    from_rusinkiewicz,
+    from_signed_angle,
+    from_tr75,
+    from_ts67,
+    signed_angle,
+    specular_to_common,
+    to_rb08,
+    to_rusinkiewicz,
+    to_tr75,
+    to_ts67,
+    unit_vectors,
+)
 
 HALF_PI = 0.5 * math.pi
 
@@ -67,6 +90,8 @@ __all__ = [
     "to_rusinkiewicz",
     "signed_angle",
     "from_signed_angle",
+    "specular_to_common",
+    "common_to_specular",
 ]
 
 
@@ -413,151 +438,3 @@ def ts67_theta_p(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> np.n
 def tr75_eta(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> np.ndarray:
     """TR75 eta: angle from the macroscopic to the local plane of incidence (Eq. 23), radians."""
     return _eta(*check_angles(theta_i, theta_r, phi))
-
-
-# --------------------------------------------------------------------------------------------
-# vectors and conversions (NumPy; not used inside kernels)
-# --------------------------------------------------------------------------------------------
-def unit_vectors(
-    theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike
-) -> tuple[np.ndarray, np.ndarray]:
-    """Unit vectors ``(w_i, w_r)`` of the common frame, each of shape ``(..., 3)``."""
-    ti, tr, ph = (np.asarray(v, dtype=float) for v in (theta_i, theta_r, phi))
-    ti, tr, ph = np.broadcast_arrays(ti, tr, ph)
-    wi = np.stack([-np.sin(ti), np.zeros_like(ti), np.cos(ti)], axis=-1)
-    wr = np.stack([np.sin(tr) * np.cos(ph), np.sin(tr) * np.sin(ph), np.cos(tr)], axis=-1)
-    return wi, wr
-
-
-def angles_from_vectors(w_i: ArrayLike, w_r: ArrayLike) -> tuple[np.ndarray, ...]:
-    """Common-frame angles from arbitrary unit vectors ``(..., 3)`` (isotropic surfaces).
-
-    The pair is rotated about ``z`` so that ``w_i`` lies in the x-z plane on the ``-x`` side.
-    """
-    wi = np.asarray(w_i, dtype=float)
-    wr = np.asarray(w_r, dtype=float)
-    ti = np.arccos(np.clip(wi[..., 2], -1.0, 1.0))
-    tr = np.arccos(np.clip(wr[..., 2], -1.0, 1.0))
-    phi_i = np.arctan2(wi[..., 1], wi[..., 0])
-    phi_r = np.arctan2(wr[..., 1], wr[..., 0])
-    phi = np.mod(phi_r - phi_i + np.pi, 2 * np.pi)  # source at azimuth pi -> forward at 0
-    phi = np.where(phi > np.pi, phi - 2 * np.pi, phi)
-    return ti, tr, phi
-
-
-def _wrap(phi: np.ndarray) -> np.ndarray:
-    """Wrap an azimuth to (-pi, pi]."""
-    out = np.mod(phi + np.pi, 2 * np.pi) - np.pi
-    return np.where(out == -np.pi, np.pi, out)
-
-
-def from_ts67(psi: ArrayLike, theta: ArrayLike, phi: ArrayLike) -> tuple[np.ndarray, ...]:
-    """TS67 ``(psi, theta, phi)`` -> common frame; TS67's frame is the common frame (§1.3)."""
-    return tuple(np.asarray(v, dtype=float) for v in (psi, theta, phi))
-
-
-def to_ts67(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> tuple[np.ndarray, ...]:
-    """Common frame -> TS67 ``(psi, theta, phi)`` (identical conventions, docs/models.md §1.3)."""
-    return tuple(np.asarray(v, dtype=float) for v in (theta_i, theta_r, phi))
-
-
-def from_tr75(beta: ArrayLike, elevation: ArrayLike, psi: ArrayLike) -> tuple[np.ndarray, ...]:
-    """TR75 ``(beta, elevation theta, azimuth psi from the source side)`` -> common frame.
-
-    ``theta_r = pi/2 - elevation``, ``phi = pi - psi`` (docs/models.md §1.3; TR75 report
-    Eqs. 9, 11).
-    """
-    b = np.asarray(beta, dtype=float)
-    return b, HALF_PI - np.asarray(elevation, dtype=float), _wrap(np.pi - np.asarray(psi, float))
-
-
-def to_tr75(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> tuple[np.ndarray, ...]:
-    """Common frame -> TR75 ``(beta, elevation, psi)``; ``psi`` in [0, 2 pi)."""
-    psi = np.mod(np.pi - np.asarray(phi, dtype=float), 2 * np.pi)
-    return np.asarray(theta_i, float), HALF_PI - np.asarray(theta_r, float), psi
-
-
-def to_rb08(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike) -> tuple[np.ndarray, ...]:
-    """Common frame -> RB08 direction cosines ``(alpha, beta, alpha0)`` (docs/models.md §4.3).
-
-    ``alpha = sin theta_s cos phi``, ``beta = sin theta_s sin phi``, ``alpha0 = sin theta_i``;
-    the specular point is ``(alpha0, 0)`` and the retro point ``(-alpha0, 0)``.
-    """
-    tr = np.asarray(theta_r, dtype=float)
-    ph = np.asarray(phi, dtype=float)
-    return np.sin(tr) * np.cos(ph), np.sin(tr) * np.sin(ph), np.sin(np.asarray(theta_i, float))
-
-
-def from_rb08(alpha: ArrayLike, beta: ArrayLike, alpha0: ArrayLike) -> tuple[np.ndarray, ...]:
-    """RB08 direction cosines -> common frame; requires ``alpha^2 + beta^2 <= 1``."""
-    a = np.asarray(alpha, dtype=float)
-    b = np.asarray(beta, dtype=float)
-    r = np.hypot(a, b)
-    if np.any(r > 1.0 + 1e-12):
-        raise ValueError(f"direction cosines outside the unit disk: |(alpha, beta)| = {r.max()!r}")
-    a0 = np.asarray(alpha0, dtype=float)
-    if np.any((a0 < 0) | (a0 > 1)):
-        raise ValueError(f"alpha0 = sin(theta_i) must be in [0, 1], got {a0!r}")
-    return np.arcsin(a0), np.arcsin(np.minimum(r, 1.0)), np.arctan2(b, a)
-
-
-def _rot_z(v: np.ndarray, ang: np.ndarray) -> np.ndarray:
-    c, s = np.cos(ang), np.sin(ang)
-    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1], v[..., 2]], -1)
-
-
-def _rot_y(v: np.ndarray, ang: np.ndarray) -> np.ndarray:
-    c, s = np.cos(ang), np.sin(ang)
-    return np.stack([c * v[..., 0] + s * v[..., 2], v[..., 1], -s * v[..., 0] + c * v[..., 2]], -1)
-
-
-def to_rusinkiewicz(
-    theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike
-) -> tuple[np.ndarray, ...]:
-    """Common frame -> Rusinkiewicz (1998) half/difference angles ``(theta_h, theta_d, phi_d)``.
-
-    ``d`` is ``w_i`` expressed in the frame where ``h`` is the pole: rotate by ``-phi_h`` about
-    z, then by ``-theta_h`` about y; ``phi_d = atan2(d_y, d_x)`` in (-pi, pi].
-    """
-    wi, wr = unit_vectors(theta_i, theta_r, phi)
-    s = wi + wr
-    norm = np.linalg.norm(s, axis=-1, keepdims=True)
-    h = s / np.where(norm == 0, 1.0, norm)
-    th = np.arccos(np.clip(h[..., 2], -1, 1))
-    ph = np.arctan2(h[..., 1], h[..., 0])
-    d = _rot_y(_rot_z(wi, -ph), -th)
-    td = np.arccos(np.clip(d[..., 2], -1, 1))
-    pd = np.arctan2(d[..., 1], d[..., 0])
-    return th, td, pd
-
-
-def from_rusinkiewicz(
-    theta_h: ArrayLike, theta_d: ArrayLike, phi_d: ArrayLike
-) -> tuple[np.ndarray, ...]:
-    """Rusinkiewicz ``(theta_h, theta_d, phi_d)`` -> common frame ``(theta_i, theta_r, phi)``.
-
-    Directions whose ``w_i`` or ``w_r`` falls below the horizon give NaN (they are not BRDF
-    geometries); isotropy fixes ``phi_h`` so that the source lies at azimuth pi.
-    """
-    th, td, pd = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (theta_h, theta_d,
-                                                                          phi_d)))
-    d = np.stack([np.sin(td) * np.cos(pd), np.sin(td) * np.sin(pd), np.cos(td)], -1)
-    dr = d * np.array([-1.0, -1.0, 1.0])  # w_r is w_i mirrored about h
-    wi = _rot_y(d, th)
-    wr = _rot_y(dr, th)
-    ti, tr, phi = angles_from_vectors(wi, wr)
-    below = (wi[..., 2] < -1e-12) | (wr[..., 2] < -1e-12)
-    return (np.where(below, np.nan, ti), np.where(below, np.nan, tr),
-            np.where(below, np.nan, phi))
-
-
-def signed_angle(theta_r: ArrayLike, phi: ArrayLike) -> np.ndarray:
-    """In-plane signed reflection angle: ``+theta_r`` at phi = 0, ``-theta_r`` at phi = pi."""
-    tr = np.asarray(theta_r, dtype=float)
-    return np.where(np.cos(np.asarray(phi, dtype=float)) < 0, -tr, tr)
-
-
-def from_signed_angle(theta_signed: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-    """Signed in-plane angle -> ``(theta_r, phi)`` with phi in {0, pi}."""
-    t = np.asarray(theta_signed, dtype=float)
-    return np.abs(t), np.where(t < 0, np.pi, 0.0)

@@ -1,13 +1,17 @@
 """Exports of models and fits to the tools where BRDFs are used (``docs/export.md``).
 
-One module per target: :mod:`~roughbrdf.export.zemax` (Zemax OpticStudio tabular BSDF, the
-model sampled on a grid relative to the specular direction) and :mod:`~roughbrdf.export.mitsuba`
-(Mitsuba 3 scene-description dicts and XML ``<bsdf>`` elements). :func:`export` writes any of
-them to a file by the project's output rules (no file replaced unless ``overwrite=True``; each
-written atomically), which is what ``roughbrdf export`` runs. At the top level:
-``rb.export_to`` (:func:`export`), ``rb.export_zemax`` (:func:`~roughbrdf.export.zemax.to_zemax`)
-and ``rb.export_mitsuba`` (:func:`~roughbrdf.export.mitsuba.export_mitsuba`). (``rb.export`` is
-this package.)
+One module (or package) per target: :mod:`~roughbrdf.export.zemax` (Zemax OpticStudio tabular
+BSDF, the model sampled on a grid relative to the specular direction) and
+:mod:`~roughbrdf.export.mitsuba` (Mitsuba 3 scene-description dicts and XML ``<bsdf>``
+elements). :func:`export` writes any of them to a file by the project's output rules (no file
+replaced unless ``overwrite=True``; each written atomically), which is what ``roughbrdf
+export`` runs. At the top level: ``rb.export_to`` (:func:`export`), ``rb.export_zemax`` and
+``rb.export_mitsuba``. (``rb.export`` is this package.)
+
+``export_zemax`` *is* :func:`roughbrdf.export.zemax.to_zemax` and ``export_mitsuba`` *is*
+:func:`roughbrdf.export.mitsuba.export_mitsuba` (the same function objects, with their
+signatures and docstrings), loaded on first use (PEP 562 module ``__getattr__``) so that
+``import roughbrdf.export`` loads no NumPy.
 """
 
 from __future__ import annotations
@@ -17,9 +21,13 @@ import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import ArgumentError
+
+if TYPE_CHECKING:  # for type checkers and IDEs; at run time the two load on first use
+    from .mitsuba import export_mitsuba
+    from .zemax import to_zemax as export_zemax
 
 __all__ = ["TARGETS", "ExportResult", "export", "export_mitsuba", "export_to", "export_zemax",
            "target_name"]
@@ -152,16 +160,27 @@ def _write_mitsuba(files: dict[Path, dict[str, Any]], target: str, overwrite: bo
 #: ``rb.export_to``: ``rb.export`` is this package
 export_to = export
 
-
-def export_zemax(*args: Any, **kwargs: Any) -> Any:
-    """:func:`roughbrdf.export.zemax.to_zemax` (``rb.export_zemax``)."""
-    from .zemax import to_zemax
-
-    return to_zemax(*args, **kwargs)
+#: the public names that are a target module's function, loaded on first use
+_LAZY = ("export_zemax", "export_mitsuba")
 
 
-def export_mitsuba(*args: Any, **kwargs: Any) -> Any:
-    """:func:`roughbrdf.export.mitsuba.export_mitsuba` (``rb.export_mitsuba``)."""
-    from .mitsuba import export_mitsuba as _export
+def __getattr__(name: str) -> Any:
+    """``export_zemax`` (:func:`roughbrdf.export.zemax.to_zemax` itself) and ``export_mitsuba``
+    (:func:`roughbrdf.export.mitsuba.export_mitsuba` itself), imported on first access."""
+    found: Any
+    if name == "export_zemax":
+        from .zemax import to_zemax
 
-    return _export(*args, **kwargs)
+        found = to_zemax
+    elif name == "export_mitsuba":
+        from .mitsuba import export_mitsuba
+
+        found = export_mitsuba
+    else:  # any other name: the usual error of a missing module attribute
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = found  # later accesses find it without coming here
+    return found
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_LAZY})

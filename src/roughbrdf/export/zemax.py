@@ -41,14 +41,14 @@ from typing import Any
 import numpy as np
 
 from ..errors import ArgumentError
+from ..geometry import specular_to_common
 from ..integrate import albedo
 from ..io.zemax import (
     HORIZON_EPS,
     SYMMETRIES,
     ZemaxGrid,
-    _normalize_symmetry,
     grid_from_radians,
-    specular_to_common,
+    normalize_symmetry,
     table_integral,
     write_table,
 )
@@ -130,7 +130,7 @@ def default_grid(model: Model, *, angles_of_incidence: Any = None,
     >>> g.aoi_deg[-1], g.radial_deg[-1], len(g.azimuth_deg)
     (80.0, 170.0, 19)
     """
-    sym = _normalize_symmetry(str(symmetry))
+    sym = normalize_symmetry(str(symmetry))
     if sym is None:
         raise ArgumentError("symmetry", f"must be one of {', '.join(SYMMETRIES)}",
                             value=symmetry)

@@ -16,6 +16,9 @@ The two pages are one set (:class:`roughbrdf.output.ResultFolder`): added to the
 or, given ``into=`` (the catalogue's own open set), committed with ``catalogue.csv`` and
 ``catalogue.json``; a kill leaves both old pages or both new ones.
 
+The page's style sheet and script are package data, ``roughbrdf/catalogue/assets/summary.css``
+and ``summary.js`` (:data:`ASSETS`), copied into each page.
+
 The thumbnails are the per-fit PNGs referenced by relative path, not embedded: the page lives
 in the catalogue folder beside them, and embedding 60 figures as data URIs would add several
 megabytes to a page that must stay small at 100,000 rows. The page fetches nothing else.
@@ -38,12 +41,14 @@ Examples
 
 from __future__ import annotations
 
+import functools
 import html
 import json
 import math
 import os
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
+from importlib import resources
 from pathlib import Path
 from typing import Any
 from urllib.parse import quote, urlsplit
@@ -242,124 +247,16 @@ def _thumbnails_html(rows: Sequence[Mapping[str, Any]], max_thumbnails: int) -> 
 # the page
 # --------------------------------------------------------------------------------------------
 
-_CSS = """
-body{font:14px/1.4 system-ui,sans-serif;margin:1.5em;color:#222}
-h1{font-size:1.4em}h2{font-size:1.15em;margin-top:1.5em}
-table{border-collapse:collapse;font-size:13px}
-th,td{border:1px solid #ccc;padding:2px 6px;white-space:nowrap}
-td.num{text-align:right;font-variant-numeric:tabular-nums}
-td.err{white-space:normal;max-width:30em;color:#a00}
-th{background:#eee;cursor:pointer;user-select:none;position:sticky;top:0}
-th[aria-sort=ascending]::after{content:" \\25B2"}th[aria-sort=descending]::after{content:" \\25BC"}
-tr.st-failed td{background:#fde8e8}tr.st-not-converged td{background:#fff6dc}
-tr.st-skipped td{color:#777}
-#controls{margin:.5em 0;display:flex;gap:.6em;align-items:center;flex-wrap:wrap}
-.counts td:first-child{font-weight:bold}
-.plots,.sheet{display:flex;flex-wrap:wrap;gap:12px}
-.plot{margin:0}.plot svg{background:#fafafa;border:1px solid #ddd}
-.plot rect{fill:#4878a8}.plot text{font-size:10px;fill:#444}.plot .axis{stroke:#888}
-.plot figcaption{font-size:12px;text-align:center}
-.thumb{display:flex;flex-direction:column;width:240px;font-size:11px;color:#333;
- text-decoration:none;border:1px solid #ddd;padding:2px}
-.thumb img{width:240px;height:auto}
-"""
+#: the page's style sheet and script, package data beside this module (``assets/``), inlined
+#: into every page
+ASSETS = ("summary.css", "summary.js")
 
-_JS = r"""
-(function () {
-  "use strict";
-  var D = JSON.parse(document.getElementById("rb-data").textContent);
-  var cols = D.columns, n = D.links.length, size = D.pageSize;
-  var data = cols.map(function (c, j) {
-    var dict = D.dicts[c.key], col = D.data[j];
-    return dict ? col.map(function (i) { return dict[i]; }) : col;
-  });
-  var statusCol = data[cols.findIndex(function (c) { return c.key === "status"; })];
-  var view = [], page = 0, sortCol = -1, dir = 1, search = null;
-  var collator = new Intl.Collator(undefined, {numeric: true, sensitivity: "base"});
-  var thead = document.querySelector("#rb-table thead tr");
-  var tbody = document.querySelector("#rb-table tbody");
-  var info = document.getElementById("rb-info");
-  var missing = function (v) { return v === null || v === undefined || v === ""; };
 
-  function compare(a, b) {
-    var x = data[sortCol][a], y = data[sortCol][b];
-    if (missing(x)) { return missing(y) ? a - b : 1; }
-    if (missing(y)) { return -1; }
-    var c = cols[sortCol].type === "num" ? x - y : collator.compare(x, y);
-    return c ? c * dir : a - b;
-  }
-  function applySort() { if (sortCol >= 0) { view.sort(compare); } }
-  function applyFilter(q) {
-    q = q.trim().toLowerCase();
-    view = [];
-    if (q && !search) {
-      search = new Array(n);
-      for (var i = 0; i < n; i++) {
-        search[i] = data.map(function (col) { return missing(col[i]) ? "" : col[i]; })
-          .join(" ").toLowerCase();
-      }
-    }
-    for (var k = 0; k < n; k++) { if (!q || search[k].indexOf(q) >= 0) { view.push(k); } }
-    applySort();
-    page = 0;
-  }
-  function fmt(v, type) {
-    if (missing(v)) { return ""; }
-    if (type === "num" && !Number.isInteger(v)) {
-      var a = Math.abs(v);
-      return a && (a < 1e-3 || a >= 1e6) ? v.toExponential(3) : Number(v.toPrecision(4)).toString();
-    }
-    return String(v);
-  }
-  function render() {
-    var pages = Math.max(1, Math.ceil(view.length / size));
-    page = Math.min(Math.max(page, 0), pages - 1);
-    var start = page * size, stop = Math.min(view.length, start + size);
-    var frag = document.createDocumentFragment();
-    for (var i = start; i < stop; i++) {
-      var r = view[i], tr = document.createElement("tr");
-      tr.className = "st-" + String(statusCol[r]).split(" ")[0].replace("not", "not-converged");
-      cols.forEach(function (c, j) {
-        var td = document.createElement("td"), v = data[j][r];
-        td.className = c.type === "num" ? "num" : (c.key === "error" ? "err" : "");
-        if (c.key === "file" && D.links[r]) {
-          var a = document.createElement("a");
-          a.href = D.links[r]; a.textContent = fmt(v, c.type); td.appendChild(a);
-        } else { td.textContent = fmt(v, c.type); }
-        tr.appendChild(td);
-      });
-      frag.appendChild(tr);
-    }
-    tbody.textContent = "";
-    tbody.appendChild(frag);
-    info.textContent = view.length ? "rows " + (start + 1) + "\u2013" + stop + " of " +
-      view.length + " (page " + (page + 1) + " of " + pages + ")" : "no rows";
-    document.getElementById("rb-prev").disabled = page === 0;
-    document.getElementById("rb-next").disabled = page >= pages - 1;
-  }
-  cols.forEach(function (c, j) {
-    var th = document.createElement("th");
-    th.textContent = c.label; th.dataset.key = c.key; th.title = "sort by " + c.label;
-    th.addEventListener("click", function () {
-      if (sortCol === j) { dir = -dir; } else { sortCol = j; dir = 1; }
-      Array.prototype.forEach.call(thead.children, function (h) {
-        h.removeAttribute("aria-sort");
-      });
-      th.setAttribute("aria-sort", dir > 0 ? "ascending" : "descending");
-      applySort(); page = 0; render();
-    });
-    thead.appendChild(th);
-  });
-  document.getElementById("rb-prev").addEventListener("click", function () { page--; render(); });
-  document.getElementById("rb-next").addEventListener("click", function () { page++; render(); });
-  document.getElementById("rb-filter").addEventListener("input", function (e) {
-    applyFilter(e.target.value); render();
-  });
-  applyFilter("");
-  render();
-  document.body.dataset.ready = "1";
-})();
-"""
+@functools.cache
+def _asset(name: str) -> str:
+    """The text of ``assets/<name>`` (one of :data:`ASSETS`), read once per process."""
+    path = resources.files("roughbrdf.catalogue").joinpath("assets", name)
+    return path.read_text(encoding="utf-8")
 
 
 def _counts(rows: Sequence[Mapping[str, Any]]) -> list[tuple[str, int]]:
@@ -392,7 +289,7 @@ def _html_page(rows: Sequence[Mapping[str, Any]], title: str, page_size: int,
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">
 <meta name="viewport" content="width=device-width, initial-scale=1">
-<link rel="icon" href="data:,"><title>{t}</title><style>{_CSS}</style></head>
+<link rel="icon" href="data:,"><title>{t}</title><style>\n{_asset("summary.css")}</style></head>
 <body><h1>{t}</h1>
 <p>{len(rows)} fits (file × channel); {len(params)} fitted parameters.</p>
 <table class="counts"><tbody>{counts}</tbody></table>
@@ -405,7 +302,7 @@ def _html_page(rows: Sequence[Mapping[str, Any]], title: str, page_size: int,
 <h2>Parameters across the catalogue</h2>{_plots_html(rows, params)}
 <h2>Contact sheet</h2>{_thumbnails_html(rows, max_thumbnails)}
 <script type="application/json" id="rb-data">{_json_for_script(data)}</script>
-<script>{_JS}</script>
+<script>\n{_asset("summary.js")}</script>
 </body></html>
 """
 

@@ -1,4 +1,4 @@
-"""Readers and writers of measured-BRDF files; one module per format.
+"""Readers and writers of measured-BRDF files; one module per format (Zemax: a package).
 
 ========  ====================  ==============================================  ======  ======
 format    extensions            module                                          read    write

@@ -16,7 +16,7 @@ import roughbrdf as rb
 from roughbrdf.fitting import ChannelData, Objective, ObjectiveSpec
 from roughbrdf.fitting.data import Comparison, excluded_text
 from roughbrdf.fitting.search import MultiStart, SearchOptions, screen, sobol_points
-from roughbrdf.fitting.setup import FreeParameters
+from roughbrdf.fitting.plan import FreeParameters
 from roughbrdf.fitting.statistics import Covariance, GoodnessOfFit
 from roughbrdf.fitting.threads import single_thread_blas
 from roughbrdf.measurement import Measurement

@@ -28,7 +28,7 @@ if _TYPE_CHECKING:  # for type checkers and IDEs; at run time the names load on 
     from . import diffuse, distributions, fresnel, geometry, shadowing
     from .catalogue import fit_catalogue
     from .export import export_mitsuba, export_to, export_zemax
-    from .fitting import FitResult, compare, fit
+    from .fitting import FitOptions, FitResult, compare, fit
     from .integrate import albedo, reciprocity_error
     from .io import read, write
     from .measurement import Measurement
@@ -47,6 +47,7 @@ __all__ = [
     "export_zemax",
     "fit",
     "fit_catalogue",
+    "FitOptions",
     "FitResult",
     "fresnel",
     "geometry",
@@ -63,6 +64,7 @@ __all__ = [
 
 #: public name -> submodule that defines it (loaded on first access)
 _ATTRS = {
+    "FitOptions": "fitting",
     "FitResult": "fitting",
     "fit": "fitting",
     "compare": "fitting",

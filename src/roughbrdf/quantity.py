@@ -1,6 +1,6 @@
-"""What a value means: the :class:`Quantity` type and the one closed-form relative scale.
+"""What a value means and how a fit compares it: the :class:`Quantity` and :class:`Loss` types.
 
-One type serves measurements, fitting, plotting and model evaluation:
+:class:`Quantity`, one type for measurements, fitting, plotting and model evaluation:
 
 ``brdf``
     The standard BRDF ``f_r`` in sr⁻¹ (reflected radiance / incident irradiance).
@@ -14,12 +14,19 @@ One type serves measurements, fitting, plotting and model evaluation:
     ``docs/models.md`` §2.7); *data* marked relative are compared with a model through the
     closed-form scale of :func:`relative_scale`.
 
+The fit :class:`Loss` (``docs/fitting.md``, "What is minimized") owns its names
+(:data:`LOSSES`), what data it needs (the log loss: positive values), its residual and the
+residual's derivative in the data scale ``K``, the closed-form ``K`` (:func:`relative_scale`)
+and the line a report shows.
+
 Examples
 --------
->>> from roughbrdf.quantity import Quantity
+>>> from roughbrdf.quantity import Loss, Quantity
 >>> Quantity.parse("BRIDF").cosine_weighted
 True
 >>> Quantity.parse("brdf") == "brdf"
+True
+>>> Loss.parse("log").positive_data
 True
 """
 
@@ -31,10 +38,15 @@ from enum import StrEnum
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["Quantity", "relative_scale", "LOSSES"]
+from .errors import ArgumentError
 
-#: the fit losses :func:`relative_scale` knows (``docs/fitting.md``)
+__all__ = ["Quantity", "Loss", "relative_scale", "LOSSES", "F_FLOOR"]
+
+#: the fit losses (``docs/fitting.md``): the values of :class:`Loss`
 LOSSES = ("relative", "log", "absolute")
+#: floor applied to model values before dividing or taking logs, relative to the largest
+#: ``|x|``: a model value of exactly 0 (e.g. an underflowed Beckmann lobe) must not give inf
+F_FLOOR = 1e-12
 
 
 class Quantity(StrEnum):
@@ -89,6 +101,113 @@ class Quantity(StrEnum):
         return rel.compared_with()
 
 
+class Loss(StrEnum):
+    """The residual of a fit (a ``str``: compares equal to its name; ``docs/fitting.md``).
+
+    With ``x`` the measured value, ``f`` the model value (floored at :meth:`floor`: ``fs``) and
+    ``K`` the data scale, one residual per sample (before the weight):
+
+    * ``relative`` (default): ``(K x - f)/f``, computed ``(K x)/fs - 1``; its r.m.s. is TR75's
+      sigma (Eq. 34);
+    * ``log``: ``ln(K x) - ln f``, computed ``ln x + ln K - ln fs``;
+    * ``absolute``: ``K x - f``; with ``weights="uncertainty"`` the usual chi-square.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> Loss.parse("relative").residual(np.array([2.0]), np.array([1.0]), floor=0.0).tolist()
+    [1.0]
+    >>> Loss.ABSOLUTE.text
+    'absolute, x - f'
+    """
+
+    RELATIVE = "relative"
+    LOG = "log"
+    ABSOLUTE = "absolute"
+
+    @classmethod
+    def parse(cls, value: object, name: str = "loss") -> Loss:
+        """The loss named by ``value`` (exactly its name); an
+        :class:`~roughbrdf.errors.ArgumentError` naming ``name`` and the value otherwise."""
+        if isinstance(value, cls):
+            return value
+        if not isinstance(value, str) or value not in LOSSES:  # no case folding: as before
+            raise ArgumentError(name, f"unknown loss {value!r}; choose one of "
+                                f"{', '.join(LOSSES)}")
+        return cls(value)
+
+    @property
+    def positive_data(self) -> bool:
+        """Whether the data must be positive (``log``: ``ln x``)."""
+        return self is Loss.LOG
+
+    @property
+    def ratio(self) -> bool:
+        """Whether the residual compares ``x`` with ``f`` by ratio (``relative``, ``log``): a
+        model value of 0 leaves such a sample without a residual."""
+        return self is not Loss.ABSOLUTE
+
+    @property
+    def text(self) -> str:
+        """The report's ``loss`` line."""
+        return _LOSS_TEXT[self]
+
+    @staticmethod
+    def floor(x: np.ndarray) -> float:
+        """The floor of model values for data ``x``: :data:`F_FLOOR` times the largest ``|x|``."""
+        return F_FLOOR * max(float(np.max(np.abs(x))), 1e-300)
+
+    def uncertainty_weight(self, x: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """``weights="uncertainty"``: ``1/u`` for the absolute loss, ``|x|/u`` (the inverse
+        relative uncertainty) for the relative and log losses."""
+        return 1.0 / u if self is Loss.ABSOLUTE else np.abs(x) / u
+
+    def residual(self, x: np.ndarray, f: np.ndarray, *, k: float = 1.0, floor: float,
+                 logx: np.ndarray | None = None) -> np.ndarray:
+        """The unweighted residuals of data ``x`` (scale ``k``) against model values ``f``
+        floored at ``floor``; ``logx``: ``ln x`` computed once (log loss)."""
+        fs = np.maximum(f, floor)
+        if self is Loss.RELATIVE:
+            return (k * x) / fs - 1.0
+        if self is Loss.ABSOLUTE:
+            return k * x - f
+        if logx is None:
+            logx = np.log(x)
+        return logx + math.log(k) - np.log(fs)
+
+    def scale_derivative(self, x: np.ndarray, f: np.ndarray, k: float, floor: float
+                         ) -> np.ndarray:
+        """``d r / d K`` at fixed model values ``f`` (analytic): the scale's Jacobian column."""
+        if self is Loss.RELATIVE:
+            return x / np.maximum(f, floor)
+        if self is Loss.ABSOLUTE:
+            return x.copy()
+        return np.full(x.shape[0], 1.0 / k)
+
+    def closed_form(self, d: np.ndarray, f: np.ndarray, w2: np.ndarray | None) -> float:
+        """The optimum ``K`` of :func:`relative_scale` on usable 1-D pairs (dot products: one
+        pass)."""
+        if self is Loss.RELATIVE:
+            q = d / f
+            wq = q if w2 is None else w2 * q
+            den = float(np.dot(wq, q))
+            return float(wq.sum()) / den if den > 0 else 1.0
+        if self is Loss.ABSOLUTE:
+            wd = d if w2 is None else w2 * d
+            den = float(np.dot(wd, d))
+            return float(np.dot(wd, f)) / den if den > 0 else 1.0
+        r = np.log(f) - np.log(d)
+        if w2 is None:
+            return math.exp(float(r.mean()))
+        wsum = float(w2.sum())
+        return math.exp(float(np.dot(w2, r)) / wsum) if wsum > 0 else 1.0
+
+
+#: the report's line of each loss
+_LOSS_TEXT = {Loss.RELATIVE: "relative, (x - f)/f  (TR75 Eq. 34)",
+              Loss.LOG: "log, ln x - ln f", Loss.ABSOLUTE: "absolute, x - f"}
+
+
 def relative_scale(data: ArrayLike, model: ArrayLike, *, weights: ArrayLike | None = None,
                    loss: str = "relative") -> float:
     """The closed-form scale ``K`` that puts data of unknown scale onto a model: ``K·data ≈ model``.
@@ -122,7 +241,8 @@ def relative_scale(data: ArrayLike, model: ArrayLike, *, weights: ArrayLike | No
     ok = np.isfinite(d) & np.isfinite(f) & (f > 0)
     if w2 is not None:
         ok &= np.isfinite(w2)
-    if loss == "log":
+    kind = Loss(loss)
+    if kind.positive_data:
         ok &= d > 0
     if not ok.all():  # only usable pairs take part (copies: the common case needs none)
         if not ok.any():
@@ -131,23 +251,5 @@ def relative_scale(data: ArrayLike, model: ArrayLike, *, weights: ArrayLike | No
         w2 = None if w2 is None else w2[ok]
     d, f = d.ravel(), f.ravel()
     w2 = None if w2 is None else w2.ravel()
-    k = _closed_form(d, f, w2, loss)
+    k = kind.closed_form(d, f, w2)
     return k if math.isfinite(k) and k > 0 else 1.0
-
-
-def _closed_form(d: np.ndarray, f: np.ndarray, w2: np.ndarray | None, loss: str) -> float:
-    """The optimum K of :func:`relative_scale` on usable 1-D pairs (dot products: one pass)."""
-    if loss == "relative":
-        q = d / f
-        wq = q if w2 is None else w2 * q
-        den = float(np.dot(wq, q))
-        return float(wq.sum()) / den if den > 0 else 1.0
-    if loss == "absolute":
-        wd = d if w2 is None else w2 * d
-        den = float(np.dot(wd, d))
-        return float(np.dot(wd, f)) / den if den > 0 else 1.0
-    r = np.log(f) - np.log(d)
-    if w2 is None:
-        return math.exp(float(r.mean()))
-    wsum = float(w2.sum())
-    return math.exp(float(np.dot(w2, r)) / wsum) if wsum > 0 else 1.0

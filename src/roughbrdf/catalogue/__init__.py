@@ -27,19 +27,23 @@ import os
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import ArgumentError
+from ..models.factory import as_model, is_auto, model_label
 from ..output import LOCK, MANIFEST
 from .resume import completed_rows, file_sha256, fingerprint
 from .tasks import Task
+
+if TYPE_CHECKING:
+    from ..fitting.options import FitOptions
 
 __all__ = ["fit_catalogue", "CatalogueResult", "expand_inputs", "folder_names",
            "check_options", "CATALOGUE_FILES", "RESERVED"]
 
 #: the catalogue's own files in its folder
 CATALOGUE_FILES = ("catalogue.csv", "catalogue.json")
-#: the files of the summary page (:mod:`roughbrdf.catalogue.summary`, when it exists)
+#: the files of the summary page (:mod:`roughbrdf.catalogue.summary`)
 SUMMARY_FILES = ("summary.md", "summary.html")
 #: names no fit folder may take: the catalogue's own entries (and its manifest and lock)
 RESERVED = (*CATALOGUE_FILES, *SUMMARY_FILES, MANIFEST, LOCK)
@@ -172,7 +176,7 @@ def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model
                   read_options: Mapping[str, Any] | None = None,
                   candidates: Any = None, cv: bool = True, time_limit: float | None = None,
                   retries: int = 1, progress: bool | None = None,
-                  **fit_options: Any) -> CatalogueResult:
+                  options: FitOptions | None = None, **fit_options: Any) -> CatalogueResult:
     """Fit ``model`` to every input file, one task per file, on ``dask.distributed``.
 
     Parameters
@@ -211,8 +215,12 @@ def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model
         How often a task is run again when its worker died under it.
     progress : bool or None
         Progress bar (files, channels, failures, ETA); None: on an interactive terminal.
+    options : FitOptions, optional
+        The options of every file's fit (:class:`roughbrdf.fitting.FitOptions`; its
+        ``progress`` is not used: each fit runs without a bar).
     **fit_options
-        Every option of :func:`roughbrdf.fit` (``fix``, ``bounds``, ``loss``, ``starts``, ...).
+        Options of :func:`roughbrdf.fit` by name (``fix``, ``bounds``, ``loss``, ``starts``,
+        ...), replacing those of ``options``.
 
     Returns
     -------
@@ -224,22 +232,25 @@ def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model
     finished is complete and no catalogue file is written.
     """
     from ..output import ResultFolder
+    from . import summary  # the summary page (imports NumPy: loaded when a catalogue runs)
     from .run import run_tasks
 
     if client is not None and scheduler is not None:
         raise ArgumentError("scheduler", "give either a client or a scheduler address",
                             value=scheduler)
-    check_options(model, fit_options, read_options=read_options, time_limit=time_limit,
-                  retries=retries, n_workers=n_workers)
+    fit_opts = check_options(model, fit_options, read_options=read_options,
+                             time_limit=time_limit, retries=retries, n_workers=n_workers,
+                             options=options)
     files = expand_inputs(inputs)
     out = Path(out_dir)
-    opts = {"fit": fit_options, "read": dict(read_options or {}), "plots": plots,
+    # the fingerprint of --resume: the options that differ from the defaults
+    changed = {k: v for k, v in fit_opts.changed().items() if k != "progress"}
+    opts = {"fit": changed, "read": dict(read_options or {}), "plots": plots,
             "candidates": candidates, "cv": cv}
     fp = fingerprint(model, opts)
     label = _label(model)
     tasks, kept = [], {}
-    summary = _summary_module()
-    own = (*CATALOGUE_FILES, *(SUMMARY_FILES if summary is not None else ()))
+    own = (*CATALOGUE_FILES, *SUMMARY_FILES)
     # the catalogue files and the summary pages are one set (adopt: pages an older version
     # wrote outside the set may be replaced with --force/--resume)
     with ResultFolder(out, overwrite=overwrite or resume, adopt=SUMMARY_FILES) as cat:
@@ -254,7 +265,7 @@ def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model
                 ResultFolder(folder).check([])
             tasks.append((i, Task(file=f, path=os.path.abspath(f), folder=str(folder.resolve()),
                                   fit_dir=name, model=model, fingerprint=fp, label=label,
-                                  fit_options=dict(fit_options), read_options=opts["read"],
+                                  options=fit_opts, read_options=opts["read"],
                                   candidates=candidates, cv=cv, plots=plots,
                                   overwrite=overwrite or resume)))
         done = run_tasks(tasks, model, client=client, scheduler=scheduler, n_workers=n_workers,
@@ -265,23 +276,24 @@ def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model
 
         cat.add("catalogue.csv", csv_text(rows))
         cat.add("catalogue.json", json_text(rows, model=label))
-        if summary is not None:
-            summary.write_summary(out, rows, overwrite=overwrite or resume, into=cat)
+        summary.write_summary(out, rows, overwrite=overwrite or resume, into=cat)
     return CatalogueResult(rows=rows, out_dir=out, written=[out / n for n in own])
 
 
-def check_options(model: Any, fit_options: Mapping[str, Any], *,
+def check_options(model: Any, fit_options: Mapping[str, Any] | None = None, *,
                   read_options: Mapping[str, Any] | None = None, time_limit: float | None = None,
-                  retries: int = 1, n_workers: int | None = None) -> None:
-    """Check the options of :func:`fit_catalogue` once, before any cluster starts.
+                  retries: int = 1, n_workers: int | None = None,
+                  options: FitOptions | None = None) -> FitOptions:
+    """Check the options of :func:`fit_catalogue` once, before any cluster starts; the fit
+    options of every task (``options`` with ``fit_options`` by name replacing fields).
 
     Every option that a worker would reject for *any* file raises here
     (:class:`~roughbrdf.errors.ArgumentError` naming the argument), instead of failing each
-    file on the workers: unknown keywords of :func:`roughbrdf.fit`, and the checks of
-    :class:`roughbrdf.fitting.setup.FitPlan` (loss, starts, seed, subsample, fix, bounds,
-    aperture, fit domain ...) run on a small stand-in measurement, without fitting. Options
-    whose validity depends on the file (a channel label, ``quantity=`` against what the file
-    says) are left to the task.
+    file on the workers: unknown keywords of :func:`roughbrdf.fit`, the checks of
+    :class:`roughbrdf.fitting.FitOptions` (loss, starts, seed, subsample, aperture, fit
+    domain ...) and those of :class:`roughbrdf.fitting.plan.FitPlan` (fix, bounds) on a small
+    stand-in measurement, without fitting. Options whose validity depends on the file (a
+    channel label, ``quantity=`` against what the file says) are left to the task.
 
     Examples
     --------
@@ -290,60 +302,51 @@ def check_options(model: Any, fit_options: Mapping[str, Any], *,
     ...
     roughbrdf.errors.ArgumentError: starts must be >= 1 (an integer), got 0
     """
-    import inspect
+    import dataclasses
 
-    from .. import fitting
+    from ..fitting.options import FitOptions
 
     _check_run_options(time_limit, retries, n_workers)
     if read_options:
         _check_read_options(read_options)
-    known = inspect.signature(fitting.fit).parameters
-    for name in fit_options:  # a misspelt keyword: TypeError on every worker otherwise
-        if name not in known or name in ("model", "measurement", "progress"):
+    known = {f.name for f in dataclasses.fields(FitOptions)}
+    for name in fit_options or {}:  # a misspelt keyword: TypeError on every worker otherwise
+        if name not in known or name == "progress":  # the catalogue has its own bar
             raise ArgumentError(name, f"{name}= is not an option of roughbrdf.fit (known: "
-                                f"{', '.join(sorted(set(known) - {'model', 'measurement'}))})")
-    opts = {n: p.default for n, p in known.items() if p.default is not inspect.Parameter.empty}
-    opts.update(fit_options)
-    seed = opts["seed"]
+                                f"{', '.join(sorted(known))})")
+    opts = FitOptions.of(options, fit_options, caller="fit_catalogue").replace(progress=False)
+    seed = opts.seed
     # numpy's generators refuse a negative seed ("expected non-negative integer") on the worker
     if seed is not None and not isinstance(seed, bool) and isinstance(seed, int) and seed < 0:
         raise ArgumentError("seed", "must be None or an integer >= 0", value=seed)
-    _check_channel(opts["channel"])
-    if not isinstance(opts["joint"], bool):  # rb.fit checks it only after reading the data
-        raise ArgumentError("joint", "must be True or False", value=opts["joint"])
-    if opts["shared"] is not None and not opts["joint"]:
-        raise ArgumentError("shared", "only a joint fit shares parameters: ask for one with "
-                            "joint=True (command line: --joint)", value=opts["shared"])
+    _check_channel(opts.channel)
     _check_plan(model, opts)
+    return opts
 
 
-def _check_plan(model: Any, opts: dict[str, Any]) -> None:
-    """:class:`~roughbrdf.fitting.setup.FitPlan`'s checks of ``opts`` on a stand-in
+def _check_plan(model: Any, opts: FitOptions) -> None:
+    """:class:`~roughbrdf.fitting.plan.FitPlan`'s checks of ``opts`` on a stand-in
     measurement (a few directions; relative data when ``relative_to`` is given)."""
-    import inspect
-
     import numpy as np
 
-    from ..fitting.setup import FitPlan, as_model
+    from ..fitting.plan import FitPlan
     from ..measurement import Measurement
     from ..quantity import Quantity
 
-    auto = isinstance(model, str) and model.strip().lower() == "auto"
+    auto = is_auto(model)
     if auto:
         for name in ("fix", "bounds"):  # as fit_auto: the candidates' parameters differ
-            if opts.get(name):
+            if getattr(opts, name):
                 raise ArgumentError(name, "names parameters of one model; with model 'auto' "
                                     "the candidates have different parameters: choose the "
-                                    "model", value=opts[name])
+                                    "model", value=getattr(opts, name))
         # the other options do not depend on the model: a stand-in candidate checks them
-        opts = {**opts, "fix": (), "bounds": None}
+        opts = opts.replace(fix=(), bounds=None)
     m = as_model("lambertian" if auto else model)
     t = np.radians(np.array([10.0, 20.0, 30.0, 40.0]))
     probe = Measurement(t, t, np.zeros(4), np.ones(4), quantity=Quantity.parse(
-        "relative" if opts.get("relative_to") else "brdf"))
-    wanted = inspect.signature(FitPlan.of).parameters
-    FitPlan.of(m, probe, **{k: v for k, v in opts.items()
-                            if k in wanted and k not in ("model", "measurement")})
+        "relative" if opts.relative_to else "brdf"))
+    FitPlan.of(m, probe, opts)
 
 
 def _check_run_options(time_limit: float | None, retries: Any, n_workers: Any) -> None:
@@ -383,20 +386,6 @@ def _check_channel(channel: Any) -> None:
 
 def _label(model: Any) -> str:
     """The model's label for the rows; an unknown model name fails here, before any work."""
-    if isinstance(model, str) and model.strip().lower() == "auto":
+    if is_auto(model):
         return "auto"
-    from ..fitting.setup import as_model, model_label
-
     return model_label(as_model(model))
-
-
-def _summary_module() -> Any:
-    """:mod:`roughbrdf.catalogue.summary` (the summary page) if it exists, else None."""
-    import importlib
-
-    try:
-        return importlib.import_module(f"{__name__}.summary")
-    except ModuleNotFoundError as exc:
-        if exc.name != f"{__name__}.summary":
-            raise
-        return None

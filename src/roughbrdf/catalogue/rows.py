@@ -75,7 +75,7 @@ def failed_row(file: str, model: str, error: str, *, sha256: str | None,
 def fit_rows(res: FitResult, file: str, *, fit_dir: str, figures: Sequence[str | None],
              elapsed_s: float) -> list[dict[str, Any]]:
     """One row per channel of ``res`` (``figures[i]``: the channel's PNG, relative, or None)."""
-    from ..fitting.result import clean_json
+    from ..jsonsafe import clean_json
 
     src = res.source or {}
     rows = []
@@ -115,7 +115,7 @@ def csv_text(rows: Sequence[dict[str, Any]]) -> str:
 
 def json_text(rows: Sequence[dict[str, Any]], **extra: Any) -> str:
     """``catalogue.json``: ``{"rows": rows, **extra}`` (strict JSON, NaN as null)."""
-    from ..fitting.result import clean_json
+    from ..jsonsafe import clean_json
 
     return json.dumps(clean_json({**extra, "rows": list(rows)}), indent=1,
                       allow_nan=False) + "\n"

@@ -11,10 +11,15 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from ..jsonsafe import clean_json
+from ..models.factory import is_auto
 from .resume import TASK_FILE, file_sha256
 from .rows import failed_row, fit_rows
+
+if TYPE_CHECKING:
+    from ..fitting.options import FitOptions
 
 __all__ = ["Task", "run_task"]
 
@@ -39,6 +44,8 @@ class Task:
         Model and options (:func:`~roughbrdf.catalogue.resume.fingerprint`).
     label : str
         The model's label, for the rows of a file that failed.
+    options : FitOptions or None
+        The options of the fit (None: the defaults); fitted without a progress bar.
     """
 
     file: str
@@ -48,7 +55,7 @@ class Task:
     model: Any
     fingerprint: str
     label: str
-    fit_options: dict[str, Any] = field(default_factory=dict)
+    options: FitOptions | None = None
     read_options: dict[str, Any] = field(default_factory=dict)
     candidates: Any = None
     cv: bool = True
@@ -72,16 +79,16 @@ def _fit_and_save(task: Task, sha: str | None, t0: float) -> list[dict[str, Any]
     import json
 
     from .. import io as _io
-    from ..fitting import fit
+    from ..fitting import FitOptions, fit
     from ..fitting.compare import fit_auto
-    from ..fitting.result import clean_json
     from ..output import ResultFolder
 
     meas = _io.read(task.path, **task.read_options)
-    if isinstance(task.model, str) and task.model.strip().lower() == "auto":
-        res = fit_auto(meas, task.candidates, cv=task.cv, progress=False, **task.fit_options)
+    options = (task.options or FitOptions()).replace(progress=False)
+    if is_auto(task.model):
+        res = fit_auto(meas, task.candidates, cv=task.cv, options=options)
     else:
-        res = fit(task.model, meas, progress=False, **task.fit_options)
+        res = fit(task.model, meas, options=options)
     files = res.files(plots=task.plots)
     pngs = res.plot_names() if task.plots else [None] * len(res.channels)
     figures = [None if p is None else f"{task.fit_dir}/{p}" for p in pngs]

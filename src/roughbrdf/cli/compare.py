@@ -9,31 +9,18 @@ replaced without ``--force``). The fit options are those of ``roughbrdf fit``.
 
 from __future__ import annotations
 
+import inspect
 import json
-from typing import Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from .common import COMPARE_OPTIONS, check_channels, handled
-from .fit import (
-    AnglesInOption,
-    ApertureOption,
-    ChannelOption,
-    CvOption,
-    FormatOption,
-    JointOption,
-    KeepExtrapolatedOption,
-    LossOption,
-    NegativeOption,
-    QuantityOption,
-    SeedOption,
-    SourceExclusionOption,
-    StartsOption,
-    ThetaRMaxOption,
-    check_aperture,
-    fit_domain,
-    read_input,
-)
+from .fit import read_input
+from .options import ReadInput, command, fit_options
+
+if TYPE_CHECKING:
+    from ..fitting.options import FitOptions
 
 #: the library's argument names -> this verb's options (errors name the options)
 OPTIONS = COMPARE_OPTIONS
@@ -42,26 +29,20 @@ OPTIONS = COMPARE_OPTIONS
 FILES = ("compare.md", "compare.json", "compare.png")
 
 
-def run_compare(file: str, models: str | None, out: str | None, *, force: bool,
-                plots: bool, cv: bool, channel: list[str] | None, angles_in: str | None,
-                quantity: str | None, file_format: str | None, aperture: float | None,
-                theta_r_max: float | None, source_exclusion: float | None,
-                **fit_options: Any) -> int:
+def run_compare(file: str, models: str | None, out: str | None, options: FitOptions,
+                read: ReadInput, *, force: bool, plots: bool, cv: bool) -> int:
     """The work of ``roughbrdf compare``; returns the exit status (0, or 1 if a candidate's fit
     did not converge)."""
     from ..fitting.compare import compare
-    from ..fitting.result import clean_json
+    from ..jsonsafe import clean_json
     from ..output import ResultFolder
 
-    ap = check_aperture(aperture)
-    t_max, excl = fit_domain(theta_r_max, source_exclusion)
-    meas = read_input(file, file_format, quantity, angles_in)
-    check_channels(meas, channel)  # an unknown label listed with the file's channels
+    meas = read_input(file, read.file_format, read.quantity, read.angles_in)
+    check_channels(meas, options.channel)  # an unknown label listed with the file's channels
     names = [n for n in FILES if plots or not n.endswith(".png")]
     if out is not None:
         ResultFolder(out, overwrite=force).check(names)
-    res = compare(meas, models, cv=cv, channel=list(channel) if channel else None,
-                  aperture=ap, theta_r_max=t_max, source_exclusion=excl, **fit_options)
+    res = compare(meas, models, cv=cv, options=options)
     typer.echo(res.table())
     if out is not None:
         files: dict[str, Any] = {
@@ -79,40 +60,35 @@ def run_compare(file: str, models: str | None, out: str | None, *, force: bool,
     return 0 if all(c.result.success for c in res.candidates) else 1
 
 
+#: the parameters of ``roughbrdf compare``, in the order of its help
+COMPARE_ORDER = ["file", "models", "out", "cv", "channel", "loss", "starts", "joint", "quantity",
+                 "angles_in", "file_format", "aperture", "theta_r_max", "source_exclusion",
+                 "keep_extrapolated", "negative", "seed", "plots", "force"]
+#: the verb's own parameters (the shared ones: :data:`roughbrdf.cli.options.TABLE`)
+COMPARE_OWN: dict[str, tuple[Any, Any]] = {
+    "file": (Annotated[str, typer.Argument(help="measurement file")], inspect.Parameter.empty),
+    "models": (Annotated[str, typer.Option(
+        "--models", metavar="SPEC,SPEC,...",
+        help="candidates, e.g. 'tr75, coated(lobes=2)' (default: the --model auto set)")], None),
+    "out": (Annotated[str, typer.Option(
+        "--out", "-o", help="also write compare.md, compare.json, compare.png here")], None),
+    "plots": (Annotated[bool, typer.Option("--plots/--no-plots", help="write compare.png")],
+              True),
+    "force": (Annotated[bool, typer.Option("--force", help="replace an earlier run's results")],
+              False),
+}
+
+
 def register(app: typer.Typer) -> None:
-    @app.command("compare")
-    def compare_cmd(
-        file: str = typer.Argument(..., help="measurement file"),
-        models: str = typer.Option(None, "--models", metavar="SPEC,SPEC,...",
-                                   help="candidates, e.g. 'tr75, coated(lobes=2)' (default: "
-                                        "the --model auto set)"),
-        out: str = typer.Option(None, "--out", "-o",
-                                help="also write compare.md, compare.json, compare.png here"),
-        cv: CvOption = True,
-        channel: ChannelOption = None,
-        loss: LossOption = "relative",
-        starts: StartsOption = 8,
-        joint: JointOption = False,
-        quantity: QuantityOption = None,
-        angles_in: AnglesInOption = None,
-        file_format: FormatOption = None,
-        aperture: ApertureOption = None,
-        theta_r_max: ThetaRMaxOption = None,
-        source_exclusion: SourceExclusionOption = None,
-        keep_extrapolated: KeepExtrapolatedOption = False,
-        negative: NegativeOption = "keep",
-        seed: SeedOption = 0,
-        plots: bool = typer.Option(True, "--plots/--no-plots", help="write compare.png"),
-        force: bool = typer.Option(False, "--force", help="replace an earlier run's results"),
-    ) -> None:
+    def compare_cmd(**values: Any) -> None:
         """Fit candidate models to a file and compare them (sigma, rms-log, AIC/BIC, CV)."""
         with handled(OPTIONS):
-            code = run_compare(file, models, out, force=force, plots=plots, cv=cv,
-                               channel=channel, angles_in=angles_in, quantity=quantity,
-                               file_format=file_format, aperture=aperture,
-                               theta_r_max=theta_r_max, source_exclusion=source_exclusion,
-                               loss=loss, starts=starts, joint=joint, negative=negative,
-                               seed=seed,
-                               extrapolated="keep" if keep_extrapolated else "drop")
+            # candidates' fits without a bar unless asked (as rb.compare's keywords)
+            options = fit_options(values, progress=False)
+            code = run_compare(values["file"], values["models"], values["out"], options,
+                               ReadInput.of(values), force=values["force"],
+                               plots=values["plots"], cv=values["cv"])
         if code:
             raise typer.Exit(code)
+
+    app.command("compare")(command(compare_cmd, COMPARE_ORDER, COMPARE_OWN))

@@ -33,6 +33,7 @@ Exit status 1 when the fit did not converge for some channel (the results are wr
 from __future__ import annotations
 
 import errno
+import inspect
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -40,8 +41,10 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from .common import FIT_OPTIONS, angle_names, check_channels, cli_model, handled, parse_params
+from .options import ModelInput, ReadInput, command, fit_options
 
 if TYPE_CHECKING:
+    from ..fitting.options import FitOptions
     from ..measurement import Measurement
     from ..models import Model
 
@@ -51,68 +54,6 @@ OPTIONS = FIT_OPTIONS
 #: spellings of --angles-in -> the readers' angles= option
 ANGLE_UNITS = {"deg": "deg", "degree": "deg", "degrees": "deg", "rad": "rad", "radian": "rad",
                "radians": "rad"}
-
-
-# the options of model choice, joint fits and the fit domain, shared with `roughbrdf compare`
-ModelsOption = Annotated[str | None, typer.Option(
-    "--models", metavar="SPEC,SPEC,...",
-    help="with --model auto: the candidates (default: trowbridge-reitz-1975, coated, "
-         "coated(lobes=2), coated(lobes=2, distribution=beckmann))")]
-CvOption = Annotated[bool, typer.Option(
-    "--cv/--no-cv", help="leave-one-incidence-out cross-validation score (model choice)")]
-JointOption = Annotated[bool, typer.Option(
-    "--joint", help="fit all channels at once, roughness and index shared")]
-SharedOption = Annotated[list[str] | None, typer.Option(
-    "--shared", help="with --joint: a parameter shared by the channels (repeatable; default: "
-                     "all but the reflectances)")]
-KeepExtrapolatedOption = Annotated[bool, typer.Option(
-    "--keep-extrapolated", help="also fit values the file holds beyond the instrument's "
-                                "measured range (default: left out and counted)")]
-
-
-ParamOption = Annotated[list[str] | None, typer.Option(
-    "-p", "--param", help="starting value or option, name=value (repeatable; angles such as "
-                         "Oren-Nayar sigma in degrees)")]
-FixOption = Annotated[list[str] | None, typer.Option(
-    "--fix", help="keep this parameter at its value (repeatable)")]
-BoundsOption = Annotated[list[str] | None, typer.Option(
-    "--bounds", metavar="NAME=LOW:HIGH",
-    help="search range of a parameter, e.g. e=0.1:2 (repeatable; names as for --fix; angles "
-         "such as sigma in degrees; a default starting value outside it starts in the middle)")]
-ChannelOption = Annotated[list[str] | None, typer.Option(
-    "--channel", "-c", help="channel label or index (repeatable; default: all)")]
-LossOption = Annotated[str, typer.Option(help="relative ((x-f)/f, TR75), log or absolute")]
-StartsOption = Annotated[int, typer.Option(help="multistart points per channel")]
-QuantityOption = Annotated[str | None, typer.Option(
-    help="input: what the file's values are, if the file does not say: brdf, brdf_cos "
-         "(= bridf), bridf or relative")]
-AnglesInOption = Annotated[str | None, typer.Option(
-    "--angles-in", metavar="deg|rad",
-    help="input: angle unit of an ASTM or CSV file, overriding the file")]
-RelativeToOption = Annotated[str | None, typer.Option(
-    "--relative-to",
-    help="for relative data: brdf or bridf (default: the file's relative_to, else brdf)")]
-FormatOption = Annotated[str | None, typer.Option(
-    "--format", help="override the format chosen from the extension")]
-NonfiniteOption = Annotated[str, typer.Option(help="non-finite values: raise or drop")]
-NegativeOption = Annotated[str, typer.Option(help="negative values: keep, drop or clip")]
-SeedOption = Annotated[int, typer.Option(help="seed of the Sobol starts and the subsample")]
-FreeScaleOption = Annotated[bool | None, typer.Option(
-    "--free-scale/--no-free-scale",
-    help="fit a free scale K of the data in closed form (x -> K x; default: only for "
-         "relative data)")]
-ApertureOption = Annotated[float | None, typer.Option(
-    "--aperture", metavar="DEG",
-    help="instrument aperture: half-angle in degrees of a uniform cone about the reflection "
-         "direction; the model is averaged over it (default: none)")]
-ThetaRMaxOption = Annotated[float | None, typer.Option(
-    "--theta-r-max", metavar="DEG",
-    help="fit domain: leave out samples with theta_r above DEG (counted; default: none)")]
-SourceExclusionOption = Annotated[float | None, typer.Option(
-    "--source-exclusion", metavar="DEG",
-    help="fit domain: leave out samples within DEG of the direction toward the source "
-         "(retro-blocked; counted; default: none)")]
-PlotsOption = Annotated[bool, typer.Option("--plots/--no-plots", help="write PNG plots")]
 
 
 def build_model(spec: str, params: dict[str, Any] | None = None) -> Model:
@@ -254,16 +195,6 @@ def result_names(meas: Measurement, channel: list[str] | None, plots: bool,
     return names
 
 
-def fit_domain(theta_r_max: float | None, source_exclusion: float | None
-               ) -> tuple[float | None, float | None]:
-    """``--theta-r-max``, ``--source-exclusion`` (degrees) -> radians, checked by the library
-    (errors name the options, in degrees)."""
-    from ..fitting.data import check_fit_domain
-
-    return check_fit_domain(*(None if v is None else math.radians(v)
-                              for v in (theta_r_max, source_exclusion)))
-
-
 def auto_options(models: str | None, param: list[str] | None, fix: list[str] | None,
                  bounds: list[str] | None, auto: bool) -> None:
     """Refuse what ``--model auto`` cannot take (and ``--models`` without it)."""
@@ -279,52 +210,40 @@ def auto_options(models: str | None, param: list[str] | None, fix: list[str] | N
                              f"with roughbrdf compare")
 
 
-def check_aperture(aperture: float | None) -> float | None:
-    """``--aperture DEG`` -> radians (None: no aperture); a clear error outside [0, 90)."""
-    if aperture is None:
-        return None
-    if not (math.isfinite(aperture) and 0 <= aperture < 90):
-        raise ValueError(f"--aperture must be a half-angle in degrees, 0 <= DEG < 90; got "
-                         f"{aperture!r}")
-    return math.radians(aperture)
+def resolve_model(given: ModelInput, options: FitOptions) -> tuple[Model | str, FitOptions]:
+    """The model (``"auto"`` as such) and ``options`` with ``--fix`` and ``--bounds`` resolved
+    on it (a default starting value outside ``--bounds`` moved inside); what ``--model auto``
+    cannot take (and ``--models`` without it) is refused."""
+    auto_options(given.models, given.param, given.fix, given.bounds, given.auto)
+    if given.auto:
+        return "auto", options
+    params = parse_params(given.param)
+    m = build_model(given.spec, params)
+    fixed = resolve_names(m, list(given.fix or []))
+    ranges = parse_bounds(m, given.bounds)
+    return start_within(m, ranges, params), options.replace(fix=fixed, bounds=ranges or None)
 
 
-def run_fit(file: str, model: str, out: str, *, param: list[str] | None,
-            fix: list[str] | None, bounds: list[str] | None, channel: list[str] | None,
-            angles_in: str | None, quantity: str | None, file_format: str | None,
-            aperture: float | None, plots: bool, force: bool, quiet: bool,
-            theta_r_max: float | None = None, source_exclusion: float | None = None,
-            models: str | None = None, cv: bool = True, **fit_options: Any) -> int:
+def run_fit(file: str, out: str, given: ModelInput, options: FitOptions, read: ReadInput, *,
+            cv: bool, plots: bool, force: bool, quiet: bool) -> int:
     """The work of ``roughbrdf fit``; returns the exit status (0, or 1 if not converged).
 
-    Everything that can be checked is checked before the fit: the options, the input file,
-    and that ``out`` may receive the results (:meth:`roughbrdf.output.ResultFolder.check`).
+    Everything that can be checked is checked before the fit: the options (``options`` were
+    checked when made), the input file, and that ``out`` may receive the results
+    (:meth:`roughbrdf.output.ResultFolder.check`).
     """
     from ..fitting import fit
     from ..fitting.compare import fit_auto
     from ..output import ResultFolder
 
-    ap = check_aperture(aperture)
-    t_max, excl = fit_domain(theta_r_max, source_exclusion)
-    auto = model.strip().lower() == "auto"
-    auto_options(models, param, fix, bounds, auto)
-    if not auto:
-        given = parse_params(param)
-        m = build_model(model, given)
-        fixed = resolve_names(m, list(fix or []))
-        ranges = parse_bounds(m, bounds)
-        m = start_within(m, ranges, given)
-    meas = read_input(file, file_format, quantity, angles_in)
-    chans = list(channel) if channel else None
-    ResultFolder(out, overwrite=force).check(result_names(meas, chans, plots, auto))
-    # labels or positions as text; Measurement.channel_index resolves both ("525" also finds
-    # "525nm")
-    common = {"channel": chans, "aperture": ap, "theta_r_max": t_max, "source_exclusion": excl,
-              "progress": None if not quiet else False, **fit_options}
-    if auto:
-        res = fit_auto(meas, models, cv=cv, **common)
+    m, options = resolve_model(given, options)
+    meas = read_input(file, read.file_format, read.quantity, read.angles_in)
+    chans = None if options.channel is None else [str(c) for c in options.channel]
+    ResultFolder(out, overwrite=force).check(result_names(meas, chans, plots, given.auto))
+    if given.auto:
+        res = fit_auto(meas, given.models, cv=cv, options=options)
     else:
-        res = fit(m, meas, fix=fixed, bounds=ranges or None, **common)
+        res = fit(m, meas, options=options)
     # the report in degrees with the unit named, on the terminal and in report.txt (fit.json
     # keeps the library's radians)
     written = res.save(out, plots=plots, overwrite=force, report_angles="deg")
@@ -335,57 +254,40 @@ def run_fit(file: str, model: str, out: str, *, param: list[str] | None,
     return 0 if res.success else 1
 
 
+#: the parameters of ``roughbrdf fit``, in the order of its help
+FIT_ORDER = ["file", "model", "models", "cv", "joint", "shared", "keep_extrapolated", "out",
+             "param", "fix", "bounds", "channel", "loss", "starts", "quantity", "angles_in",
+             "relative_to", "file_format", "nonfinite", "negative", "seed", "free_scale",
+             "aperture", "theta_r_max", "source_exclusion", "plots", "force", "quiet"]
+#: the verb's own parameters (the shared ones: :data:`roughbrdf.cli.options.TABLE`)
+FIT_OWN: dict[str, tuple[Any, Any]] = {
+    "file": (Annotated[str, typer.Argument(help="measurement file (.astm, .dat/.alta, .csv, "
+                                                ".binary)")], inspect.Parameter.empty),
+    "model": (Annotated[str, typer.Option(
+        "--model", "-m", help="model name, spec or sum, e.g. trowbridge-reitz-1975, "
+                              "coated(lobes=2) or microfacet+lambertian (aliases: roughbrdf "
+                              "models); auto: the lowest BIC of the candidates (--models)")],
+              inspect.Parameter.empty),
+    "out": (Annotated[str, typer.Option("--out", "-o", help="output folder (refused if it "
+                                                             "holds results, unless --force)")],
+            inspect.Parameter.empty),
+    "force": (Annotated[bool, typer.Option(
+        "--force", help="replace the results of an earlier run in --out (files roughbrdf did "
+                        "not write are never replaced)")], False),
+    "quiet": (Annotated[bool, typer.Option("--quiet", "-q", help="no report on the terminal")],
+              False),
+}
+
+
 def register(app: typer.Typer) -> None:
-    @app.command("fit")
-    def fit_cmd(
-        file: str = typer.Argument(..., help="measurement file (.astm, .dat/.alta, .csv, "
-                                             ".binary)"),
-        model: str = typer.Option(..., "--model", "-m",
-                                  help="model name, spec or sum, e.g. trowbridge-reitz-1975, "
-                                       "coated(lobes=2) or microfacet+lambertian (aliases: "
-                                       "roughbrdf models); auto: the lowest BIC of the "
-                                       "candidates (--models)"),
-        models: ModelsOption = None,
-        cv: CvOption = True,
-        joint: JointOption = False,
-        shared: SharedOption = None,
-        keep_extrapolated: KeepExtrapolatedOption = False,
-        out: str = typer.Option(..., "--out", "-o", help="output folder (refused if it holds "
-                                                          "results, unless --force)"),
-        param: ParamOption = None,
-        fix: FixOption = None,
-        bounds: BoundsOption = None,
-        channel: ChannelOption = None,
-        loss: LossOption = "relative",
-        starts: StartsOption = 8,
-        quantity: QuantityOption = None,
-        angles_in: AnglesInOption = None,
-        relative_to: RelativeToOption = None,
-        file_format: FormatOption = None,
-        nonfinite: NonfiniteOption = "raise",
-        negative: NegativeOption = "keep",
-        seed: SeedOption = 0,
-        free_scale: FreeScaleOption = None,
-        aperture: ApertureOption = None,
-        theta_r_max: ThetaRMaxOption = None,
-        source_exclusion: SourceExclusionOption = None,
-        plots: PlotsOption = True,
-        force: bool = typer.Option(False, "--force",
-                                   help="replace the results of an earlier run in --out (files "
-                                        "roughbrdf did not write are never replaced)"),
-        quiet: bool = typer.Option(False, "--quiet", "-q", help="no report on the terminal"),
-    ) -> None:
+    def fit_cmd(**values: Any) -> None:
         """Fit a model to a measurement file; write fit.json, report.txt and plots into --out."""
         with handled(OPTIONS):
-            code = run_fit(file, model, out, param=param, fix=fix, bounds=bounds,
-                           channel=channel, angles_in=angles_in, quantity=quantity,
-                           file_format=file_format, aperture=aperture,
-                           theta_r_max=theta_r_max, source_exclusion=source_exclusion,
-                           plots=plots,
-                           force=force, quiet=quiet, loss=loss, starts=starts, seed=seed,
-                           free_scale=free_scale, nonfinite=nonfinite, negative=negative,
-                           relative_to=relative_to, models=models, cv=cv, joint=joint,
-                           shared=shared or None,
-                           extrapolated="keep" if keep_extrapolated else "drop")
+            options = fit_options(values, progress=None if not values["quiet"] else False)
+            code = run_fit(values["file"], values["out"], ModelInput.of(values), options,
+                           ReadInput.of(values), cv=values["cv"], plots=values["plots"],
+                           force=values["force"], quiet=values["quiet"])
         if code:
             raise typer.Exit(code)
+
+    app.command("fit")(command(fit_cmd, FIT_ORDER, FIT_OWN))

@@ -15,37 +15,18 @@ converge; 130 on Ctrl-C (finished fit folders are complete, no catalogue file is
 
 from __future__ import annotations
 
-from typing import Annotated, Any
+import inspect
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from .common import handled, parse_params
-from .fit import (
-    OPTIONS,
-    AnglesInOption,
-    ApertureOption,
-    BoundsOption,
-    ChannelOption,
-    CvOption,
-    FixOption,
-    FormatOption,
-    FreeScaleOption,
-    JointOption,
-    KeepExtrapolatedOption,
-    LossOption,
-    ModelsOption,
-    NegativeOption,
-    NonfiniteOption,
-    ParamOption,
-    PlotsOption,
-    QuantityOption,
-    RelativeToOption,
-    SeedOption,
-    SharedOption,
-    SourceExclusionOption,
-    StartsOption,
-    ThetaRMaxOption,
-)
+from .common import handled
+from .fit import OPTIONS, resolve_model
+from .options import ModelInput, command, fit_options
+
+if TYPE_CHECKING:
+    from ..fitting.options import FitOptions
 
 #: the library's argument names -> this verb's options (errors name the options)
 BATCH_OPTIONS = {**OPTIONS, "n_workers": "--workers", "scheduler": "--scheduler",
@@ -111,50 +92,45 @@ def check_search(starts: int, loss: str, seed: int, relative_to: str | None = No
                              f"bridf)") from None
 
 
-def run_batch(paths: list[str], model: str, out: str, *, param: list[str] | None,
-              fix: list[str] | None, bounds: list[str] | None, models: str | None, cv: bool,
-              workers: int | None, scheduler: str | None, resume: bool, force: bool,
-              plots: bool, quiet: bool, time_limit: float | None, aperture: float | None,
-              theta_r_max: float | None, source_exclusion: float | None,
-              read: dict[str, Any], **fit_options: Any) -> int:
+@dataclass(frozen=True)
+class BatchRun:
+    """How ``fit-batch`` runs: the cluster (``--workers``, ``--scheduler``), ``--resume``,
+    ``--force``, ``--plots``, ``--quiet``, ``--time-limit``, ``--cv`` and the reading options."""
+
+    workers: int | None = None
+    scheduler: str | None = None
+    resume: bool = False
+    force: bool = False
+    plots: bool = True
+    quiet: bool = False
+    time_limit: float | None = None
+    cv: bool = True
+    read: dict[str, Any] = field(default_factory=dict)
+
+    def check(self) -> None:
+        """The cluster and the limit, in CLI terms, before any cluster starts."""
+        if self.workers is not None and self.scheduler is not None:
+            raise ValueError("--workers sets the size of a local cluster; with --scheduler the "
+                             "cluster's own workers run the fits: give one of them")
+        if self.workers is not None and self.workers < 1:
+            raise ValueError(f"--workers must be >= 1 (got {self.workers})")
+        if self.time_limit is not None and not self.time_limit > 0:  # also NaN
+            raise ValueError(f"--time-limit must be a number of seconds > 0 (got "
+                             f"{self.time_limit:g})")
+
+
+def run_batch(paths: list[str], out: str, given: ModelInput, options: FitOptions,
+              run: BatchRun) -> int:
     """The work of ``roughbrdf fit-batch``; the exit status (0, or 1 if a file failed or a fit
     did not converge). Options are checked before any cluster starts."""
     from ..catalogue import fit_catalogue
-    from .fit import (
-        auto_options,
-        build_model,
-        check_aperture,
-        fit_domain,
-        parse_bounds,
-        resolve_names,
-        start_within,
-    )
 
-    if workers is not None and scheduler is not None:
-        raise ValueError("--workers sets the size of a local cluster; with --scheduler the "
-                         "cluster's own workers run the fits: give one of them")
-    if workers is not None and workers < 1:
-        raise ValueError(f"--workers must be >= 1 (got {workers})")
-    if time_limit is not None and not time_limit > 0:  # also NaN
-        raise ValueError(f"--time-limit must be a number of seconds > 0 (got {time_limit:g})")
-    check_search(fit_options["starts"], fit_options["loss"], fit_options["seed"],
-                 fit_options["relative_to"])
-    t_max, excl = fit_domain(theta_r_max, source_exclusion)
-    auto = model.strip().lower() == "auto"
-    auto_options(models, param, fix, bounds, auto)
-    m: Any = "auto"
-    if not auto:
-        given = parse_params(param)
-        m = build_model(model, given)
-        fit_options["fix"] = resolve_names(m, list(fix or []))
-        ranges = parse_bounds(m, bounds)
-        fit_options["bounds"] = ranges or None
-        m = start_within(m, ranges, given)
-    res = fit_catalogue(paths, m, out, scheduler=scheduler, n_workers=workers, resume=resume,
-                        overwrite=force, plots=plots, read_options=read, candidates=models,
-                        cv=cv, time_limit=time_limit, progress=None if not quiet else False,
-                        aperture=check_aperture(aperture), theta_r_max=t_max,
-                        source_exclusion=excl, **fit_options)
+    m, options = resolve_model(given, options)
+    res = fit_catalogue(paths, m, out, scheduler=run.scheduler, n_workers=run.workers,
+                        resume=run.resume, overwrite=run.force, plots=run.plots,
+                        read_options=run.read, candidates=given.models, cv=run.cv,
+                        time_limit=run.time_limit, progress=None if not run.quiet else False,
+                        options=options)
     files = {r["file"] for r in res.rows}
     for r in res.failed:
         typer.echo(f"failed: {r['file']}: {r['error']}", err=True)
@@ -168,59 +144,55 @@ def run_batch(paths: list[str], model: str, out: str, *, param: list[str] | None
     return 0 if res.success else 1
 
 
+#: the parameters of ``roughbrdf fit-batch``, in the order of its help
+BATCH_ORDER = ["paths", "model", "out", "workers", "scheduler", "resume", "time_limit",
+               "models", "cv", "joint", "shared", "keep_extrapolated", "param", "fix",
+               "bounds", "channel", "loss", "starts", "quantity", "angles_in", "relative_to",
+               "file_format", "nonfinite", "negative", "seed", "free_scale", "aperture",
+               "theta_r_max", "source_exclusion", "plots", "force", "quiet"]
+#: the verb's own parameters (the shared ones: :data:`roughbrdf.cli.options.TABLE`)
+BATCH_OWN: dict[str, tuple[Any, Any]] = {
+    "paths": (Annotated[list[str], typer.Argument(
+        metavar="PATH...",
+        help="measurement files, folders or glob patterns (quoted: 'data/*.astm')")],
+        inspect.Parameter.empty),
+    "model": (Annotated[str, typer.Option(
+        "--model", "-m", help="model name, spec or sum (as for roughbrdf fit); auto: lowest "
+                              "BIC")], inspect.Parameter.empty),
+    "out": (Annotated[str, typer.Option("--out", "-o", help="catalogue folder")],
+            inspect.Parameter.empty),
+    "workers": (Annotated[int, typer.Option(
+        "--workers", help="worker processes of the local cluster (default: the CPUs)")], None),
+    "scheduler": (Annotated[str, typer.Option(
+        "--scheduler", metavar="tcp://HOST:PORT",
+        help="run on this dask scheduler's workers instead")], None),
+    "resume": (Annotated[bool, typer.Option(
+        "--resume", help="skip inputs whose complete results exist for the same input, model "
+                         "and options")], False),
+    "time_limit": (Annotated[float, typer.Option(
+        "--time-limit", metavar="S", help="seconds a file's task may run (default: none)")],
+        None),
+    "force": (Annotated[bool, typer.Option("--force", help="replace earlier results in --out")],
+              False),
+    "quiet": (Annotated[bool, typer.Option("--quiet", "-q", help="no progress bar")], False),
+}
+
+
 def register(app: typer.Typer) -> None:
-    @app.command("fit-batch")
-    def fit_batch_cmd(
-        paths: Annotated[list[str], typer.Argument(
-            metavar="PATH...",
-            help="measurement files, folders or glob patterns (quoted: 'data/*.astm')")],
-        model: str = typer.Option(..., "--model", "-m", help="model name, spec or sum (as for "
-                                                             "roughbrdf fit); auto: lowest BIC"),
-        out: str = typer.Option(..., "--out", "-o", help="catalogue folder"),
-        workers: int = typer.Option(None, "--workers", help="worker processes of the local "
-                                                            "cluster (default: the CPUs)"),
-        scheduler: str = typer.Option(None, "--scheduler", metavar="tcp://HOST:PORT",
-                                      help="run on this dask scheduler's workers instead"),
-        resume: bool = typer.Option(False, "--resume", help="skip inputs whose complete results "
-                                    "exist for the same input, model and options"),
-        time_limit: float = typer.Option(None, "--time-limit", metavar="S",
-                                         help="seconds a file's task may run (default: none)"),
-        models: ModelsOption = None,
-        cv: CvOption = True,
-        joint: JointOption = False,
-        shared: SharedOption = None,
-        keep_extrapolated: KeepExtrapolatedOption = False,
-        param: ParamOption = None,
-        fix: FixOption = None,
-        bounds: BoundsOption = None,
-        channel: ChannelOption = None,
-        loss: LossOption = "relative",
-        starts: StartsOption = 8,
-        quantity: QuantityOption = None,
-        angles_in: AnglesInOption = None,
-        relative_to: RelativeToOption = None,
-        file_format: FormatOption = None,
-        nonfinite: NonfiniteOption = "raise",
-        negative: NegativeOption = "keep",
-        seed: SeedOption = 0,
-        free_scale: FreeScaleOption = None,
-        aperture: ApertureOption = None,
-        theta_r_max: ThetaRMaxOption = None,
-        source_exclusion: SourceExclusionOption = None,
-        plots: PlotsOption = True,
-        force: bool = typer.Option(False, "--force", help="replace earlier results in --out"),
-        quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress bar"),
-    ) -> None:
+    def fit_batch_cmd(**values: Any) -> None:
         """Fit a model to many files on dask; one fit folder each, catalogue.csv/.json."""
         with handled(BATCH_OPTIONS):
-            code = run_batch(
-                paths, model, out, param=param, fix=fix, bounds=bounds, models=models, cv=cv,
-                workers=workers, scheduler=scheduler, resume=resume, force=force, plots=plots,
-                quiet=quiet, time_limit=time_limit, aperture=aperture, theta_r_max=theta_r_max,
-                source_exclusion=source_exclusion,
-                read=read_options(quantity, angles_in, file_format), channel=channel,
-                loss=loss, starts=starts, seed=seed, free_scale=free_scale,
-                nonfinite=nonfinite, negative=negative, relative_to=relative_to, joint=joint,
-                shared=shared or None, extrapolated="keep" if keep_extrapolated else "drop")
+            run = BatchRun(values["workers"], values["scheduler"], values["resume"],
+                           values["force"], values["plots"], values["quiet"],
+                           values["time_limit"], values["cv"],
+                           read_options(values["quantity"], values["angles_in"],
+                                        values["file_format"]))
+            run.check()
+            check_search(values["starts"], values["loss"], values["seed"],
+                         values["relative_to"])
+            code = run_batch(values["paths"], values["out"], ModelInput.of(values),
+                             fit_options(values), run)
         if code:
             raise typer.Exit(code)
+
+    app.command("fit-batch")(command(fit_batch_cmd, BATCH_ORDER, BATCH_OWN))

@@ -30,17 +30,21 @@ full fit used).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import ArgumentError
+from ..models import Model, from_spec, spec_text
+from ..models.factory import split_specs
+from ..quantity import Loss
+from .channels import fit_model
+from .options import FitOptions
 
 if TYPE_CHECKING:
     from ..measurement import Measurement
-    from ..models import Model
     from .result import FitResult
 
 __all__ = ["AUTO_CANDIDATES", "THETA_R_BANDS", "Candidate", "ModelComparison", "compare",
@@ -202,44 +206,33 @@ def band_rms_log(result: FitResult) -> dict[str, float]:
     return out
 
 
-def _loss_residual(loss: str, x: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """The (unweighted) loss residual of data ``K x`` against model ``f``
-    (:mod:`~roughbrdf.fitting.objective`; ``f`` floored like there)."""
-    fs = np.maximum(f, 1e-12 * max(float(np.max(np.abs(x))), 1e-300))
-    if loss == "relative":
-        return x / fs - 1.0
-    if loss == "absolute":
-        return x - f
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(x > 0, np.log(np.where(x > 0, x, 1.0)) - np.log(fs), np.nan)
-
-
-def cross_validate(result: FitResult, fit_options: dict[str, Any]) -> float:
-    """Leave-one-incidence-out score of a fit (module notes); NaN with a single incidence."""
-    from . import fit
-
+def cross_validate(result: FitResult, options: FitOptions | Mapping[str, Any]) -> float:
+    """Leave-one-incidence-out score of a fit made with ``options`` (a
+    :class:`~roughbrdf.fitting.options.FitOptions` or its fields by name; module notes); NaN
+    with a single incidence."""
+    if not isinstance(options, FitOptions):
+        options = FitOptions.of(None, options, caller="cross_validate")
     meas = result.measurement
     angles = meas.incidences()
     if angles.size < 2:
         return math.nan
     joint = bool(result.options.get("joint"))
+    loss = Loss.parse(result.loss)
     # one local fit on all training samples from the full optimum (no exploration stage: the
     # start is already in the basin)
-    opts = {k: v for k, v in fit_options.items()
-            if k not in ("starts", "progress", "channel", "joint", "shared", "subsample")}
     held: list[np.ndarray] = []
     for g in angles:
         out = np.abs(meas.theta_i - g) < 1e-6
         train = meas.subset(~out)
-        if "weights" in opts:  # an array of weights, one per sample: the training samples'
-            opts["weights"] = _subset_weights(fit_options["weights"], meas.n_samples, ~out)
+        # an array of weights, one per sample: the training samples'
+        weights = _subset_weights(options.weights, meas.n_samples, ~out)
         groups = [result.channels] if joint else [[c] for c in result.channels]
         for group in groups:
-            labels = [c.channel for c in group]
-            fold = fit(group[0].model, train, channel=labels, starts=1, progress=False,
-                       subsample=None,
-                       joint=joint, shared=result.options["joint"]["shared"] if joint else None,
-                       **opts)
+            fold_options = options.replace(
+                channel=[c.channel for c in group], starts=1, progress=False, subsample=None,
+                joint=joint, shared=result.options["joint"]["shared"] if joint else None,
+                weights=weights)
+            fold = fit_model(group[0].model, train, fold_options)
             for c, fc in zip(group, fold.channels, strict=True):
                 idx = c.index[out[c.index]]
                 if idx.size == 0:
@@ -249,7 +242,9 @@ def cross_validate(result: FitResult, fit_options: dict[str, Any]) -> float:
                                  polarization=None if meas.polarization is None
                                  else meas.polarization[idx])
                 x = fc.scale * meas.values[idx, meas.channel_index(c.channel)]
-                held.append(_loss_residual(result.loss, x, np.asarray(f)))
+                with np.errstate(divide="ignore", invalid="ignore"):  # x <= 0: log loss
+                    # left-out samples of no log residual are not finite: filtered below
+                    held.append(loss.residual(x, np.asarray(f), floor=Loss.floor(x)))
     r = np.concatenate(held) if held else np.array([])
     r = r[np.isfinite(r)]
     return float(np.sqrt(np.mean(r * r))) if r.size else math.nan
@@ -265,13 +260,10 @@ def _subset_weights(weights: Any, n: int, keep: np.ndarray) -> Any:
 
 
 def _as_candidates(candidates: Sequence[Model | str] | str | None) -> list[Model]:
-    from ..models import Model, from_spec
-
+    """The candidate models (ArgumentError naming ``candidates`` for a bad one)."""
     if candidates is None:
         candidates = AUTO_CANDIDATES
     if isinstance(candidates, str):
-        from ..models.factory import split_specs
-
         candidates = split_specs(candidates)
     models = []
     for c in candidates:
@@ -291,7 +283,8 @@ def _as_candidates(candidates: Sequence[Model | str] | str | None) -> list[Model
 
 
 def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | None = None,
-            *, cv: bool = True, **fit_options: Any) -> ModelComparison:
+            *, cv: bool = True, options: FitOptions | None = None,
+            **keywords: Any) -> ModelComparison:
     """Fit each candidate to ``measurement`` and compare them (module notes).
 
     Parameters
@@ -303,9 +296,12 @@ def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | 
     cv : bool
         Compute the leave-one-incidence-out score (one local refit per candidate, channel
         group and incidence).
-    **fit_options
-        Passed to :func:`roughbrdf.fit` for every candidate (``loss``, ``channel``,
-        ``joint``, ``aperture``, ``theta_r_max``, ...).
+    options : FitOptions, optional
+        The options of every candidate's fit (:class:`~roughbrdf.fitting.options.FitOptions`).
+    **keywords
+        Options as keywords (``loss``, ``channel``, ``joint``, ``aperture``, ``theta_r_max``,
+        ...), replacing those of ``options``; given as keywords, ``progress`` is False unless
+        set.
 
     Returns
     -------
@@ -322,19 +318,19 @@ def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | 
     >>> res.best.label, round(res.best.sigma, 6)
     ('coated', 0.0)
     """
-    from ..models import spec_text
-    from . import fit
-
+    if options is None:  # a progress bar per candidate only when asked for
+        keywords = {"progress": False, **keywords}
+    options = FitOptions.of(options, keywords, caller="compare")
     models = _as_candidates(candidates)
     rows: list[Candidate] = []
     for m in models:
-        res = fit(m, measurement, **{"progress": False, **fit_options})
+        res = fit_model(m, measurement, options)
         k, n, aic, bic = information(res)
         rows.append(Candidate(
             spec_text(m), res, k, n, aic, bic,
             float(np.median([c.sigma for c in res.channels])),
             float(np.median([c.rms_log for c in res.channels])), band_rms_log(res),
-            cross_validate(res, fit_options) if cv else None, res.elapsed))
+            cross_validate(res, options) if cv else None, res.elapsed))
     rows.sort(key=lambda c: c.bic)
     notes = ["BIC and AIC assume independent residuals; neighbouring samples share the "
              "models' systematic misfit, so differences of this size overstate the evidence. "
@@ -350,17 +346,21 @@ def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | 
 
 
 def fit_auto(measurement: Measurement, candidates: Sequence[Model | str] | str | None = None,
-             *, cv: bool = True, **fit_options: Any) -> FitResult:
+             *, cv: bool = True, options: FitOptions | None = None,
+             **keywords: Any) -> FitResult:
     """``rb.fit("auto", ...)``: :func:`compare` the candidates and return the best fit by BIC,
     with the comparison attached (``FitResult.model_choice``: in ``fit.json``, the report and
-    ``compare.png``)."""
+    ``compare.png``). ``options`` and ``keywords`` as for :func:`compare`; ``fix`` and
+    ``bounds`` are refused (ArgumentError)."""
+    given = FitOptions.of(options, keywords, caller="fit_auto")
     for name in ("fix", "bounds"):
-        if fit_options.get(name):
+        value = getattr(given, name)
+        if value:
             raise ArgumentError(name, "names parameters of one model; with model 'auto' the "
                                 "candidates have different parameters: choose the model, or "
-                                "compare candidates (rb.compare)", value=fit_options[name])
-    fit_options = {k: v for k, v in fit_options.items() if k not in ("fix", "bounds")}
-    choice = compare(measurement, candidates, cv=cv, **fit_options)
+                                "compare candidates (rb.compare)", value=value)
+    keywords = {k: v for k, v in keywords.items() if k not in ("fix", "bounds")}
+    choice = compare(measurement, candidates, cv=cv, options=options, **keywords)
     best = choice.best.result
     best.model_choice = choice
     best.model_name = choice.best.label

@@ -31,15 +31,15 @@ from numpy.typing import ArrayLike
 from ..errors import ArgumentError
 from ..extrapolation import extrapolated_mask
 from ..instrument import Aperture, InstrumentGeometry
-from ..quantity import LOSSES, Quantity
+from ..quantity import Loss, Quantity
 
 if TYPE_CHECKING:
     from ..measurement import Measurement
     from ..models import Model
 
 __all__ = ["Comparison", "ChannelData", "DataOptions", "EXCLUSION_REASONS", "channel_weights",
-           "check_fit_domain", "check_relative_to", "excluded_text", "outside_fit_domain",
-           "input_source", "prepare_channel", "where"]
+           "check_fit_domain", "check_relative_to", "check_sample_options", "excluded_text",
+           "outside_fit_domain", "input_source", "prepare_channel", "where"]
 
 #: the reasons a sample is left out or changed, in the order reports list them
 EXCLUSION_REASONS: dict[str, str] = {
@@ -170,17 +170,19 @@ class DataOptions:
         t_max, excl = check_fit_domain(self.theta_r_max, self.source_exclusion)
         object.__setattr__(self, "theta_r_max", t_max)
         object.__setattr__(self, "source_exclusion", excl)
-        if not isinstance(self.loss, str) or self.loss not in LOSSES:
-            raise ArgumentError("loss", f"unknown loss {self.loss!r}; choose one of "
-                                f"{', '.join(LOSSES)}")
-        if not isinstance(self.nonfinite, str) or self.nonfinite not in ("raise", "drop"):
-            raise ArgumentError("nonfinite", "must be 'raise' or 'drop'", value=self.nonfinite)
-        if not isinstance(self.negative, str) or self.negative not in ("keep", "drop", "clip"):
-            raise ArgumentError("negative", "must be 'keep', 'drop' or 'clip'",
-                                value=self.negative)
-        if not isinstance(self.extrapolated, str) or self.extrapolated not in ("drop", "keep"):
-            raise ArgumentError("extrapolated", "must be 'drop' or 'keep'",
-                                value=self.extrapolated)
+        Loss.parse(self.loss)  # ArgumentError naming the loss
+        check_sample_options(self.nonfinite, self.negative, self.extrapolated)
+
+
+def check_sample_options(nonfinite: Any, negative: Any, extrapolated: Any) -> None:
+    """``nonfinite``, ``negative`` and ``extrapolated`` of :func:`roughbrdf.fit`: one of their
+    words each (:class:`~roughbrdf.errors.ArgumentError` naming the option otherwise)."""
+    if not isinstance(nonfinite, str) or nonfinite not in ("raise", "drop"):
+        raise ArgumentError("nonfinite", "must be 'raise' or 'drop'", value=nonfinite)
+    if not isinstance(negative, str) or negative not in ("keep", "drop", "clip"):
+        raise ArgumentError("negative", "must be 'keep', 'drop' or 'clip'", value=negative)
+    if not isinstance(extrapolated, str) or extrapolated not in ("drop", "keep"):
+        raise ArgumentError("extrapolated", "must be 'drop' or 'keep'", value=extrapolated)
 
 
 def _domain_angle(argument: str, value: Any, high: float, need: str) -> float | None:
@@ -338,7 +340,7 @@ def channel_weights(weights: Any, meas: Measurement, j: int, x: np.ndarray, loss
                                 "uncertainty")
         u = meas.uncertainty[:, j]
         with np.errstate(divide="ignore", invalid="ignore"):
-            w = 1.0 / u if loss == "absolute" else np.abs(x) / u
+            w = Loss.parse(loss).uncertainty_weight(x, u)
         return np.where(np.isfinite(w) & (u > 0), w, 0.0)
     try:
         w = np.asarray(weights, dtype=float)
@@ -375,7 +377,7 @@ def _bad_values(x: np.ndarray, keep: np.ndarray, excluded: dict[str, int],
                                 f"sample(s) {show}, which cannot be fitted", fix="drop")
         keep &= ~bad
         excluded["nonfinite"] = int(bad.sum())
-    log = opts.loss == "log"
+    log = Loss.parse(opts.loss).positive_data
     neg = keep & np.isfinite(x) & ((x <= 0) if log else (x < 0))
     if not neg.any():
         return
@@ -423,7 +425,7 @@ def _outside_domain(model: Model, meas: Measurement, keep: np.ndarray,
         graze = keep & (meas.theta_i >= 0.5 * math.pi)
         excluded["model_domain"] += int(graze.sum())
         keep &= ~graze
-    if opts.comparison.quantity.cosine_weighted and opts.loss != "absolute":
+    if opts.comparison.quantity.cosine_weighted and Loss.parse(opts.loss).ratio:
         # BRDF cos(theta_r) of every model is 0 at theta_r = 90 deg: a measured value there (a
         # noise floor) has no relative or logarithmic residual
         horizon = keep & (np.cos(meas.theta_r) <= 1e-12)

@@ -8,6 +8,9 @@ model value of the compared quantity (averaged over the instrument aperture if t
 * ``log``: ``w (ln(K x) - ln f)``, symmetric in over- and under-estimates;
 * ``absolute``: ``w (K x - f)``; with ``weights="uncertainty"`` the usual chi-square.
 
+Each residual, its derivative in ``K`` and the closed-form ``K`` are the loss's
+(:class:`roughbrdf.quantity.Loss`); this module weighs them and differentiates the model.
+
 For relative data ``K`` is free and solved in closed form at every evaluation
 (:func:`roughbrdf.quantity.relative_scale`, the TR75 Eq. 34 convention ``K x ~ f``;
 ``docs/models.md`` §3.9 reading (a)); otherwise it is fixed (1, or a known ``scale=``). Model
@@ -30,7 +33,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..quantity import LOSSES, Quantity, relative_scale
+from ..quantity import F_FLOOR, Loss, Quantity, relative_scale
 
 if TYPE_CHECKING:
     from ..models import Model
@@ -42,9 +45,6 @@ __all__ = ["Objective", "ObjectiveSpec", "BAD_RESIDUAL", "F_FLOOR"]
 EPS_STEP = math.sqrt(np.finfo(float).eps)
 #: central-difference step (relative)
 CENTRAL_STEP = np.finfo(float).eps ** (1.0 / 3.0)
-#: floor applied to model values before dividing or taking logs, relative to the largest
-#: ``|x|``: a model value of exactly 0 (e.g. an underflowed Beckmann lobe) must not give inf
-F_FLOOR = 1e-12
 #: residuals that are still not finite (a model that overflows at some trial parameters) are
 #: replaced by this value, so that the optimizer sees a large, finite cost and steps back
 BAD_RESIDUAL = 1e6
@@ -93,8 +93,7 @@ class ObjectiveSpec:
         object.__setattr__(self, "lower", np.asarray(self.lower, dtype=float))
         object.__setattr__(self, "upper", np.asarray(self.upper, dtype=float))
         object.__setattr__(self, "quantity", Quantity.parse(self.quantity))
-        if self.loss not in LOSSES:
-            raise ValueError(f"unknown loss {self.loss!r}; choose one of {', '.join(LOSSES)}")
+        Loss.parse(self.loss)  # an ArgumentError (a ValueError) naming the loss
         if not self.lower.shape == self.upper.shape == (len(self.free),):
             raise ValueError("lower and upper need one bound per free parameter")
 
@@ -144,8 +143,9 @@ class Objective:
         x = self.data.values
         self.x = x
         self.w = self.data.weights
-        self.floor = F_FLOOR * max(float(np.max(np.abs(x))), 1e-300)
-        self.logx = np.log(x) if self.spec.loss == "log" else None
+        self.loss = Loss.parse(self.spec.loss)
+        self.floor = Loss.floor(x)
+        self.logx = np.log(x) if self.loss.positive_data else None
 
     @property
     def n(self) -> int:
@@ -181,15 +181,7 @@ class Objective:
         """Weighted residuals for model values ``f`` and scale ``k`` (None: :meth:`scale`)."""
         if k is None:
             k = self.scale(f)
-        fs = np.maximum(f, self.floor)
-        loss = self.spec.loss
-        if loss == "relative":
-            r = (k * self.x) / fs - 1.0
-        elif loss == "absolute":
-            r = k * self.x - f
-        else:
-            assert self.logx is not None  # set for the log loss
-            r = self.logx + math.log(k) - np.log(fs)
+        r = self.loss.residual(self.x, f, k=k, floor=self.floor, logx=self.logx)
         if self.w is not None:
             r = r * self.w
         if not np.isfinite(r).all():
@@ -262,12 +254,5 @@ class Objective:
 
     def scale_column(self, f: np.ndarray, k: float) -> np.ndarray:
         """``d r / d K`` at fixed model values (analytic): the scale's Jacobian column."""
-        fs = np.maximum(f, self.floor)
-        loss = self.spec.loss
-        if loss == "relative":
-            col = self.x / fs
-        elif loss == "absolute":
-            col = self.x.copy()
-        else:
-            col = np.full(self.n, 1.0 / k)
+        col = self.loss.scale_derivative(self.x, f, k, self.floor)
         return col if self.w is None else col * self.w

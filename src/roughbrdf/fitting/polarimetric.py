@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
@@ -38,12 +38,14 @@ from numpy.typing import ArrayLike
 from ..errors import ArgumentError
 from ..instrument import InstrumentGeometry
 from ..measurement import MUELLER_ELEMENTS, Measurement
+from ..models.factory import as_model, is_auto, model_label
 from ..quantity import Quantity
 from .data import DataOptions, prepare_channel, where
 from .objective import BAD_RESIDUAL, Objective, ObjectiveSpec
+from .options import FitOptions, check_polarimetric_weight
+from .plan import FitPlan, check_enough_data
 from .result import ChannelFit, FitResult
 from .search import MultiStart, SearchOptions, SearchOutcome, progress_bar
-from .setup import FitPlan, as_model, check_enough_data, model_label
 from .threads import single_thread_blas
 
 if TYPE_CHECKING:
@@ -54,25 +56,6 @@ __all__ = ["MuellerData", "MuellerObjective", "MuellerChannelFit", "MuellerFitRe
 
 #: default relative weight of the normalized elements against ``m00`` (module notes)
 POLARIMETRIC_WEIGHT = 1.0
-
-
-def check_polarimetric_weight(value: Any) -> float:
-    """``polarimetric_weight`` as a float, finite and >= 0 (ArgumentError otherwise).
-
-    Examples
-    --------
-    >>> check_polarimetric_weight(2)
-    2.0
-    """
-    bad = isinstance(value, str | bytes | bool | complex)
-    try:
-        w = math.nan if bad else float(value)
-    except (TypeError, ValueError, OverflowError):
-        w = math.nan
-    if not (math.isfinite(w) and w >= 0.0):
-        raise ArgumentError("polarimetric_weight", "must be a finite number >= 0 (the weight "
-                            "of the normalized Mueller elements against m00)", value=value)
-    return w
 
 
 # --------------------------------------------------------------------------------------------
@@ -422,7 +405,7 @@ class MuellerFitResult(FitResult):
 def _refuse(model: Model | str, measurement: Measurement, channel: Any, joint: Any,
             shared: Any) -> None:
     """What a Mueller fit does not do, refused by argument before any work."""
-    if isinstance(model, str) and model.strip().lower() == "auto":
+    if is_auto(model):
         raise ArgumentError("model", "model='auto' compares models on BRDF data; fit Mueller "
                             "data with a named model (a facet model with an index)",
                             value=model)
@@ -438,26 +421,16 @@ def _refuse(model: Model | str, measurement: Measurement, channel: Any, joint: A
                             value=model_label(as_model(model)))
 
 
-def fit_mueller(model: Model | str, measurement: Measurement, *, loss: str = "relative",
-                weights: Any = None, fix: Iterable[str] = (),
-                bounds: Mapping[str, Sequence[float]] | None = None,
-                polarimetric_weight: float = POLARIMETRIC_WEIGHT,
-                starts: int = 8, seed: int | None = 0, nonfinite: str = "raise",
-                negative: str = "keep", relative_to: str | None = None,
-                free_scale: bool | None = None, scale: float | None = None,
-                screen: int = 64, subsample: int | None = 1000, polish: int = 2,
-                max_nfev: int | None = None, aperture: float | None = None,
-                aperture_points: int = 19, theta_r_max: float | None = None,
-                source_exclusion: float | None = None, extrapolated: str = "drop",
-                channel: Any = None, joint: bool = False, shared: Any = None,
-                progress: bool | None = None) -> MuellerFitResult:
+def fit_mueller(model: Model | str, measurement: Measurement, *,
+                options: FitOptions | None = None, **keywords: Any) -> MuellerFitResult:
     """Fit ``model`` to the Mueller elements of ``measurement`` (module notes).
 
-    The arguments are those of :func:`roughbrdf.fit` (which calls this for a measurement with
-    Mueller data), plus ``polarimetric_weight`` (``w_p``, finite and >= 0). ``loss`` applies to
-    ``m00``; the normalized elements always take the absolute difference. Samples with
-    ``m00 <= 0`` are left out with ``negative="drop"`` and raise otherwise; ``channel``,
-    ``joint``, ``shared`` and ``model="auto"`` are refused (ArgumentError).
+    The options are those of :func:`roughbrdf.fit` (which calls this for a measurement with
+    Mueller data): a :class:`~roughbrdf.fitting.options.FitOptions` or its fields as keywords;
+    ``polarimetric_weight`` is ``w_p`` (finite and >= 0; None: :data:`POLARIMETRIC_WEIGHT`).
+    ``loss`` applies to ``m00``; the normalized elements always take the absolute difference.
+    Samples with ``m00 <= 0`` are left out with ``negative="drop"`` and raise otherwise;
+    ``channel``, ``joint``, ``shared`` and ``model="auto"`` are refused (ArgumentError).
 
     Returns
     -------
@@ -465,22 +438,18 @@ def fit_mueller(model: Model | str, measurement: Measurement, *, loss: str = "re
         One channel, ``"mueller"``; ``options["mueller"]`` (in ``fit.json``) says what was
         fitted.
     """
+    options = FitOptions.of(options, keywords, caller="fit_mueller")
     t_start = time.perf_counter()
-    _refuse(model, measurement, channel, joint, shared)
+    _refuse(model, measurement, options.channel, options.joint, options.shared)
     model = as_model(model)
-    w_p = check_polarimetric_weight(polarimetric_weight)
-    plan = FitPlan.of(model, measurement, loss=loss, weights=weights, fix=fix, bounds=bounds,
-                      starts=starts, seed=seed, nonfinite=nonfinite, negative=negative,
-                      relative_to=relative_to, free_scale=free_scale, scale=scale,
-                      screen=screen, subsample=subsample, polish=polish, max_nfev=max_nfev,
-                      aperture=aperture, aperture_points=aperture_points,
-                      theta_r_max=theta_r_max, source_exclusion=source_exclusion,
-                      extrapolated=extrapolated)
+    w_p = check_polarimetric_weight(POLARIMETRIC_WEIGHT if options.polarimetric_weight is None
+                                    else options.polarimetric_weight)
+    plan = FitPlan.of(model, measurement, options)
     spec, search, opts = plan.spec, plan.search, plan.opts
     data = prepare_mueller(model, measurement, opts)
     check_enough_data(measurement, [data], spec.n_varys)  # type: ignore[list-item]
-    with progress_bar(progress, search.starts, f"fit {model_label(model)} (Mueller)") as bar, \
-            single_thread_blas():
+    label = f"fit {model_label(model)} (Mueller)"
+    with progress_bar(options.progress, search.starts, label) as bar, single_thread_blas():
         tick = None if bar is None else (lambda: bar.update(1))
         t0 = time.perf_counter()
         obj, outcome = _MuellerSearch(spec, search, w_p, tick).run(data)  # type: ignore[arg-type]

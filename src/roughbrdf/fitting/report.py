@@ -24,16 +24,13 @@ import math
 from typing import TYPE_CHECKING
 
 from ..errors import ArgumentError
+from ..quantity import Loss
 from .data import excluded_text
 
 if TYPE_CHECKING:
     from .result import ChannelFit, FitResult
 
 __all__ = ["report", "fmt", "percent", "MAX_PERCENT_RATIO"]
-
-_LOSS_TEXT = {"relative": "relative, (x - f)/f  (TR75 Eq. 34)",
-              "log": "log, ln x - ln f", "absolute": "absolute, x - f"}
-
 
 def fmt(v: float | None, digits: int = 6) -> str:
     """``v`` with ``digits`` significant digits (``"None"``, ``"nan"`` and ``"inf"`` as such).
@@ -81,7 +78,7 @@ def _header(result: FitResult) -> list[str]:
     return [f"[[Fit]] {result.model_name} to {src}",
             f"    data quantity      = {result.measurement.quantity}",
             f"    compared with      = {comp}",
-            f"    loss               = {_LOSS_TEXT[result.loss]}",
+            f"    loss               = {Loss.parse(result.loss).text}",
             *_mueller_text(result.options),
             "    aperture           = " + (
                 "none (model at each measured direction)" if ap is None else ap.describe()),

@@ -22,6 +22,7 @@ from typing import IO, TYPE_CHECKING, Any
 import numpy as np
 
 from ..instrument import Aperture, aperture_average
+from ..jsonsafe import clean_json
 from ..quantity import Quantity
 from .data import input_source
 from .statistics import Covariance, GoodnessOfFit, at_bound
@@ -197,29 +198,6 @@ class ChannelFit:
                 "scale_stderr": self.scale_stderr, "correl": self.correl,
                 "excluded": self.excluded, "nfev": self.nfev, "elapsed_s": self.elapsed,
                 "model_spec": self.model.to_dict()}
-
-
-def clean_json(v: Any) -> Any:
-    """JSON-safe copy: NaN/inf -> None, numpy scalars and arrays -> Python.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> clean_json({"a": np.float64("nan"), "b": (np.int64(2), 0.5)})
-    {'a': None, 'b': [2, 0.5]}
-    """
-    if isinstance(v, dict):
-        return {str(k): clean_json(x) for k, x in v.items()}
-    if isinstance(v, list | tuple):
-        return [clean_json(x) for x in v]
-    if isinstance(v, np.ndarray):
-        return clean_json(v.tolist())
-    if isinstance(v, np.integer):
-        return int(v)
-    if isinstance(v, float | np.floating):
-        v = float(v)
-        return v if math.isfinite(v) else None
-    return v
 
 
 @dataclass

@@ -2,12 +2,22 @@
 
 ``base`` (the :class:`Model` class and its evaluation interface, the registry), ``parameters``
 (:class:`Parameter`), ``sum`` (:class:`SumModel`), ``factory`` (:func:`model` by name or
-``"a+b"``), and one module per model.
+``"a+b"``, specs, and the naming a fit uses: :func:`as_model`, :func:`model_label`,
+:func:`is_auto`), and one module per model.
 """
 
 from .base import MODELS, Model, PreparedGeometry, SumModel, register
 from .coated import Coated
-from .factory import available, from_spec, model, resolve_names, spec_text
+from .factory import (
+    as_model,
+    available,
+    from_spec,
+    is_auto,
+    model,
+    model_label,
+    resolve_names,
+    spec_text,
+)
 from .lambertian import Lambertian
 from .microfacet import Microfacet
 from .oren_nayar import OrenNayar
@@ -22,9 +32,12 @@ __all__ = [
     "Parameter",
     "PreparedGeometry",
     "SumModel",
+    "as_model",
     "available",
     "from_spec",
+    "is_auto",
     "model",
+    "model_label",
     "register",
     "resolve_names",
     "spec_text",

@@ -1,5 +1,7 @@
-"""Building models by name: ``rb.model("tr75")``, sums from ``"tr75+lambertian"``, and the
-mapping of user-typed parameter names onto a model's (prefixed) names."""
+"""Building and naming models: ``rb.model("tr75")``, sums from ``"tr75+lambertian"``, one-line
+specs (:func:`from_spec`, :func:`spec_text`), the mapping of user-typed parameter names onto a
+model's (prefixed) names, and what a fit is given as its model (:func:`as_model`,
+:func:`model_label`, the ``"auto"`` pseudo-model: :func:`is_auto`)."""
 
 from __future__ import annotations
 
@@ -8,7 +10,11 @@ from typing import Any
 from ..registry import unknown_name
 from .base import MODELS, Model, SumModel
 
-__all__ = ["available", "from_spec", "model", "resolve_names", "spec_text", "split_specs"]
+__all__ = ["AUTO", "as_model", "available", "from_spec", "is_auto", "model", "model_label",
+           "resolve_names", "spec_text", "split_specs"]
+
+#: the pseudo-model of ``rb.fit("auto", ...)``: the candidates of model choice, best by BIC
+AUTO = "auto"
 
 
 def available() -> list[str]:
@@ -198,3 +204,36 @@ def split_specs(text: str) -> list[str]:
     for part in str(text).split(";"):
         out += [s.strip() for s in _split_top(part, ",") if s.strip()]
     return out
+
+
+def is_auto(model: object) -> bool:
+    """Whether ``model`` is the ``"auto"`` pseudo-model (any case, spaces around ignored).
+
+    Examples
+    --------
+    >>> is_auto(" Auto "), is_auto("tr75"), is_auto(None)
+    (True, False, False)
+    """
+    return isinstance(model, str) and model.strip().lower() == AUTO
+
+
+def as_model(model: Model | str) -> Model:
+    """``model`` itself, or the model of that name or spec (``"a+b"``, ``"coated(lobes=2)"``)."""
+    if isinstance(model, str):
+        model = from_spec(model)
+    if not isinstance(model, Model):
+        raise TypeError(f"model must be a roughbrdf Model or a model name, got {type(model)}")
+    return model
+
+
+def model_label(m: Model) -> str:
+    """``"a+b"`` for a sum, else the model's name.
+
+    Examples
+    --------
+    >>> import roughbrdf as rb
+    >>> model_label(rb.model("trowbridge-reitz-1975") + rb.model("lambertian"))
+    'trowbridge-reitz-1975+lambertian'
+    """
+    comps = getattr(m, "components", None)
+    return "+".join(c.name for c in comps) if comps else m.name

@@ -1,54 +1,39 @@
-"""What :func:`roughbrdf.fit` is asked to do, checked before any work (``docs/fitting.md``).
+"""The plan of one fit: what :func:`roughbrdf.fit` does with its model, measurement and
+:class:`~roughbrdf.fitting.options.FitOptions`, checked before any work (``docs/fitting.md``).
 
-The model (an instance or a registered name), the measurement, the channels, the free parameters
-and their bounds (:class:`FreeParameters`), and the data scale ``K`` (free for relative data,
-fixed otherwise: :func:`data_scale`). Every bad option raises
-:class:`~roughbrdf.errors.ArgumentError` (a ``ValueError`` naming the argument, worded for
-Python by ``str`` and for the CLI by ``render``) here, before any fit runs.
+:class:`FitPlan` holds the data options, the search, the free parameters and their bounds
+(:class:`FreeParameters`), the objective and the data scale ``K`` (free for relative data,
+fixed otherwise: :func:`data_scale`); :func:`channel_indices` and :func:`check_enough_data`
+check the channels. The options' own checks ran when they were made; the checks that need the
+model or the measurement raise here, an :class:`~roughbrdf.errors.ArgumentError` (a
+``ValueError`` naming the argument, worded for Python by ``str`` and for the CLI by
+``render``), before any fit runs.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import ArgumentError
+from ..instrument import Aperture
 from ..measurement import Measurement
 from ..models import Model, Parameter
+from ..models.factory import as_model, model_label
 from ..quantity import Quantity
 from .data import ChannelData, Comparison, DataOptions, input_source, where
 from .objective import ObjectiveSpec
+from .options import check_scale
+from .search import SearchOptions
+
+if TYPE_CHECKING:
+    from .options import FitOptions
 
 __all__ = ["BoundsFix", "FitPlan", "FreeParameters", "as_model", "channel_indices",
            "check_enough_data", "data_scale", "model_label"]
-
-
-def as_model(model: Model | str) -> Model:
-    """``model`` itself, or the model of that name or spec (``"a+b"``, ``"coated(lobes=2)"``)."""
-    if isinstance(model, str):
-        from ..models import from_spec
-
-        model = from_spec(model)
-    if not isinstance(model, Model):
-        raise TypeError(f"model must be a roughbrdf Model or a model name, got {type(model)}")
-    return model
-
-
-def model_label(m: Model) -> str:
-    """``"a+b"`` for a sum, else the model's name.
-
-    Examples
-    --------
-    >>> import roughbrdf as rb
-    >>> model_label(rb.model("trowbridge-reitz-1975") + rb.model("lambertian"))
-    'trowbridge-reitz-1975+lambertian'
-    """
-    comps = getattr(m, "components", None)
-    return "+".join(c.name for c in comps) if comps else m.name
 
 
 @dataclass(frozen=True)
@@ -165,16 +150,8 @@ def data_scale(meas: Measurement, free_scale: bool | None, scale: float | None
                ) -> tuple[bool, float]:
     """``(free_scale, fixed_scale)``: a known ``scale`` is fixed; otherwise ``K`` is free for
     relative data unless ``free_scale`` says otherwise."""
-    if scale is not None:
-        try:  # a number, not text that reads as one ("1") nor a bool
-            fixed = math.nan if isinstance(scale, str | bytes | bool) else float(scale)
-        except (TypeError, ValueError, OverflowError):
-            fixed = math.nan
-        if not (math.isfinite(fixed) and fixed > 0):
-            raise ArgumentError("scale", f"scale must be finite and > 0, got {scale!r}")
-        if free_scale:
-            raise ArgumentError("scale", "give either scale= (a known data scale) or "
-                                "free_scale=True")
+    fixed = check_scale(scale, free_scale)
+    if fixed is not None:
         return False, fixed
     if free_scale is None:
         free_scale = meas.quantity == "relative"
@@ -212,42 +189,36 @@ class FitPlan:
 
     model: Model
     opts: DataOptions
-    search: Any  # SearchOptions (imported lazily: setup does not import the search)
+    search: SearchOptions
     params: FreeParameters
     spec: ObjectiveSpec
     recorded: dict[str, Any]
 
     @classmethod
-    def of(cls, model: Model, measurement: Measurement, *, loss: str, weights: Any,
-           fix: Iterable[str], bounds: Mapping[str, Sequence[float]] | None, starts: int,
-           seed: int | None, nonfinite: str, negative: str, relative_to: str | None,
-           free_scale: bool | None, scale: float | None, screen: int,
-           subsample: int | None, polish: int, max_nfev: int | None, aperture: Any,
-           aperture_points: int, theta_r_max: float | None,
-           source_exclusion: float | None, extrapolated: str) -> FitPlan:
-        """Check every option (ArgumentError naming it) and build the plan."""
-        from ..instrument import Aperture
-        from .search import SearchOptions
-
-        ap = Aperture.parse(aperture, aperture_points)
-        opts = DataOptions(Comparison.of(measurement, relative_to), loss, weights, nonfinite,
-                           negative, ap, theta_r_max, source_exclusion, extrapolated)
-        search = SearchOptions(starts, screen, subsample, polish, max_nfev, seed)
-        k_free, k_fixed = data_scale(measurement, free_scale, scale)
-        params = FreeParameters.of(model, fix, bounds)
-        spec = params.spec(model, loss=loss, quantity=opts.comparison.quantity,
+    def of(cls, model: Model, measurement: Measurement, options: FitOptions) -> FitPlan:
+        """Check what needs the model or the measurement (ArgumentError naming the option)
+        and build the plan."""
+        o = options
+        ap = Aperture.parse(o.aperture, o.aperture_points)
+        opts = DataOptions(Comparison.of(measurement, o.relative_to), o.loss, o.weights,
+                           o.nonfinite, o.negative, ap, o.theta_r_max, o.source_exclusion,
+                           o.extrapolated)
+        search = o.search()
+        k_free, k_fixed = data_scale(measurement, o.free_scale, o.scale)
+        params = FreeParameters.of(model, o.fix, o.bounds)
+        spec = params.spec(model, loss=o.loss, quantity=opts.comparison.quantity,
                            free_scale=k_free, fixed_scale=k_fixed)
         recorded = {
-            "starts": search.starts, "seed": seed, "subsample": subsample,
-            "polish": search.polish, "nonfinite": nonfinite, "negative": negative,
-            "free_scale": k_free, "scale": scale,
+            "starts": search.starts, "seed": o.seed, "subsample": o.subsample,
+            "polish": search.polish, "nonfinite": o.nonfinite, "negative": o.negative,
+            "free_scale": k_free, "scale": o.scale,
             "aperture": None if ap is None else ap.half_angle,
             "aperture_points": None if ap is None else ap.points,
             "theta_r_max": opts.theta_r_max, "source_exclusion": opts.source_exclusion,
-            "extrapolated": extrapolated,
+            "extrapolated": o.extrapolated,
             "fix": sorted(set(model.param_names) - set(params.names)),
-            "weights": None if weights is None else
-            (weights if isinstance(weights, str) else "array")}
+            "weights": None if o.weights is None else
+            (o.weights if isinstance(o.weights, str) else "array")}
         return cls(model, opts, search, params, spec, recorded)
 
     def result_fields(self, measurement: Measurement, elapsed: float,

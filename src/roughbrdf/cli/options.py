@@ -1,0 +1,194 @@
+"""The options that ``roughbrdf fit``, ``compare`` and ``fit-batch`` share, declared once.
+
+Each option is one entry of :data:`TABLE` (its typer annotation, with the help text, and its
+default). A verb lists the names of its parameters in order (:func:`command` gives the verb
+function the :class:`inspect.Signature` typer reads) and receives them as keywords; what it got
+becomes a :class:`~roughbrdf.fitting.options.FitOptions` (:func:`fit_options`, degrees turned
+into radians and checked in CLI terms), a :class:`ModelInput` (``--model``, ``-p``, ``--fix``,
+``--bounds``, ``--models``; resolved on the model by
+:func:`roughbrdf.cli.fit.resolve_model`) and a :class:`ReadInput` (``--quantity``, ``--angles-in``,
+``--format``). Nothing heavy is imported at module level (``roughbrdf --help`` stays fast).
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Annotated, Any
+
+import typer
+
+if TYPE_CHECKING:
+    from ..fitting.options import FitOptions
+
+__all__ = ["TABLE", "ModelInput", "ReadInput", "command", "fit_options", "check_aperture",
+           "fit_domain"]
+
+# the options of model choice, joint fits and the fit domain, shared with `roughbrdf compare`
+ModelsOption = Annotated[str | None, typer.Option(
+    "--models", metavar="SPEC,SPEC,...",
+    help="with --model auto: the candidates (default: trowbridge-reitz-1975, coated, "
+         "coated(lobes=2), coated(lobes=2, distribution=beckmann))")]
+CvOption = Annotated[bool, typer.Option(
+    "--cv/--no-cv", help="leave-one-incidence-out cross-validation score (model choice)")]
+JointOption = Annotated[bool, typer.Option(
+    "--joint", help="fit all channels at once, roughness and index shared")]
+SharedOption = Annotated[list[str] | None, typer.Option(
+    "--shared", help="with --joint: a parameter shared by the channels (repeatable; default: "
+                     "all but the reflectances)")]
+KeepExtrapolatedOption = Annotated[bool, typer.Option(
+    "--keep-extrapolated", help="also fit values the file holds beyond the instrument's "
+                                "measured range (default: left out and counted)")]
+ParamOption = Annotated[list[str] | None, typer.Option(
+    "-p", "--param", help="starting value or option, name=value (repeatable; angles such as "
+                         "Oren-Nayar sigma in degrees)")]
+FixOption = Annotated[list[str] | None, typer.Option(
+    "--fix", help="keep this parameter at its value (repeatable)")]
+BoundsOption = Annotated[list[str] | None, typer.Option(
+    "--bounds", metavar="NAME=LOW:HIGH",
+    help="search range of a parameter, e.g. e=0.1:2 (repeatable; names as for --fix; angles "
+         "such as sigma in degrees; a default starting value outside it starts in the middle)")]
+ChannelOption = Annotated[list[str] | None, typer.Option(
+    "--channel", "-c", help="channel label or index (repeatable; default: all)")]
+LossOption = Annotated[str, typer.Option(help="relative ((x-f)/f, TR75), log or absolute")]
+StartsOption = Annotated[int, typer.Option(help="multistart points per channel")]
+QuantityOption = Annotated[str | None, typer.Option(
+    help="input: what the file's values are, if the file does not say: brdf, brdf_cos "
+         "(= bridf), bridf or relative")]
+AnglesInOption = Annotated[str | None, typer.Option(
+    "--angles-in", metavar="deg|rad",
+    help="input: angle unit of an ASTM or CSV file, overriding the file")]
+RelativeToOption = Annotated[str | None, typer.Option(
+    "--relative-to",
+    help="for relative data: brdf or bridf (default: the file's relative_to, else brdf)")]
+FormatOption = Annotated[str | None, typer.Option(
+    "--format", help="override the format chosen from the extension")]
+NonfiniteOption = Annotated[str, typer.Option(help="non-finite values: raise or drop")]
+NegativeOption = Annotated[str, typer.Option(help="negative values: keep, drop or clip")]
+SeedOption = Annotated[int, typer.Option(help="seed of the Sobol starts and the subsample")]
+FreeScaleOption = Annotated[bool | None, typer.Option(
+    "--free-scale/--no-free-scale",
+    help="fit a free scale K of the data in closed form (x -> K x; default: only for "
+         "relative data)")]
+ApertureOption = Annotated[float | None, typer.Option(
+    "--aperture", metavar="DEG",
+    help="instrument aperture: half-angle in degrees of a uniform cone about the reflection "
+         "direction; the model is averaged over it (default: none)")]
+ThetaRMaxOption = Annotated[float | None, typer.Option(
+    "--theta-r-max", metavar="DEG",
+    help="fit domain: leave out samples with theta_r above DEG (counted; default: none)")]
+SourceExclusionOption = Annotated[float | None, typer.Option(
+    "--source-exclusion", metavar="DEG",
+    help="fit domain: leave out samples within DEG of the direction toward the source "
+         "(retro-blocked; counted; default: none)")]
+PlotsOption = Annotated[bool, typer.Option("--plots/--no-plots", help="write PNG plots")]
+
+#: every shared option: parameter name -> (typer annotation, default)
+TABLE: dict[str, tuple[Any, Any]] = {
+    "models": (ModelsOption, None), "cv": (CvOption, True), "joint": (JointOption, False),
+    "shared": (SharedOption, None), "keep_extrapolated": (KeepExtrapolatedOption, False),
+    "param": (ParamOption, None), "fix": (FixOption, None), "bounds": (BoundsOption, None),
+    "channel": (ChannelOption, None), "loss": (LossOption, "relative"),
+    "starts": (StartsOption, 8), "quantity": (QuantityOption, None),
+    "angles_in": (AnglesInOption, None), "relative_to": (RelativeToOption, None),
+    "file_format": (FormatOption, None), "nonfinite": (NonfiniteOption, "raise"),
+    "negative": (NegativeOption, "keep"), "seed": (SeedOption, 0),
+    "free_scale": (FreeScaleOption, None), "aperture": (ApertureOption, None),
+    "theta_r_max": (ThetaRMaxOption, None), "source_exclusion": (SourceExclusionOption, None),
+    "plots": (PlotsOption, True),
+}
+#: the CLI values that are FitOptions fields as they are
+_AS_GIVEN = ("loss", "starts", "seed", "nonfinite", "negative", "relative_to", "free_scale",
+             "joint")
+
+
+def command(func: Callable[..., Any], order: list[str],
+            own: Mapping[str, tuple[Any, Any]]) -> Callable[..., Any]:
+    """``func`` (a verb taking ``**values``) with the signature typer reads: the parameters
+    ``order`` in that order, each from ``own`` (the verb's own, ``(annotation, default)``;
+    default ``inspect.Parameter.empty``: required) or else from :data:`TABLE`."""
+    params = [inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY,
+                                annotation=spec[0], default=spec[1])
+              for name in order for spec in [own.get(name) or TABLE[name]]]
+    func.__signature__ = inspect.Signature(params, return_annotation=None)  # type: ignore[attr-defined]
+    return func
+
+
+def check_aperture(aperture: float | None) -> float | None:
+    """``--aperture DEG`` -> radians (None: no aperture); a clear error outside [0, 90)."""
+    if aperture is None:
+        return None
+    if not (math.isfinite(aperture) and 0 <= aperture < 90):
+        raise ValueError(f"--aperture must be a half-angle in degrees, 0 <= DEG < 90; got "
+                         f"{aperture!r}")
+    return math.radians(aperture)
+
+
+def fit_domain(theta_r_max: float | None, source_exclusion: float | None
+               ) -> tuple[float | None, float | None]:
+    """``--theta-r-max``, ``--source-exclusion`` (degrees) -> radians, checked by the library
+    (errors name the options, in degrees)."""
+    from ..fitting.data import check_fit_domain
+
+    return check_fit_domain(*(None if v is None else math.radians(v)
+                              for v in (theta_r_max, source_exclusion)))
+
+
+def fit_options(values: Mapping[str, Any], *, progress: bool | None = None) -> FitOptions:
+    """The :class:`~roughbrdf.fitting.options.FitOptions` of a verb's values, without
+    ``--fix`` and ``--bounds`` (they need the model: :func:`roughbrdf.cli.fit.resolve_model`):
+    angles in degrees checked and turned into radians, ``--keep-extrapolated`` as
+    ``extrapolated``."""
+    from ..fitting.options import FitOptions
+
+    aperture = check_aperture(values.get("aperture"))
+    t_max, excl = fit_domain(values.get("theta_r_max"), values.get("source_exclusion"))
+    given = {k: values[k] for k in _AS_GIVEN if k in values}
+    channel = values.get("channel")
+    # labels or positions as text; Measurement.channel_index resolves both ("525" also finds
+    # "525nm")
+    return FitOptions(**given, channel=list(channel) if channel else None,
+                      shared=values.get("shared") or None, aperture=aperture,
+                      theta_r_max=t_max, source_exclusion=excl,
+                      extrapolated="keep" if values.get("keep_extrapolated") else "drop",
+                      progress=progress)
+
+
+@dataclass(frozen=True)
+class ReadInput:
+    """How to read the input: ``--format``, ``--quantity``, ``--angles-in`` as typed."""
+
+    file_format: str | None = None
+    quantity: str | None = None
+    angles_in: str | None = None
+
+    @classmethod
+    def of(cls, values: Mapping[str, Any]) -> ReadInput:
+        """The reading options among a verb's values."""
+        return cls(values.get("file_format"), values.get("quantity"), values.get("angles_in"))
+
+
+@dataclass(frozen=True)
+class ModelInput:
+    """The model as typed: ``--model``, ``-p``, ``--fix``, ``--bounds`` and ``--models``."""
+
+    spec: str
+    param: list[str] | None = None
+    fix: list[str] | None = None
+    bounds: list[str] | None = None
+    models: str | None = None
+
+    @classmethod
+    def of(cls, values: Mapping[str, Any]) -> ModelInput:
+        """The model's options among a verb's values."""
+        return cls(values["model"], values.get("param"), values.get("fix"),
+                   values.get("bounds"), values.get("models"))
+
+    @property
+    def auto(self) -> bool:
+        """``--model auto`` (model choice)."""
+        from ..models.factory import is_auto
+
+        return is_auto(self.spec)

@@ -1,0 +1,93 @@
+"""The fit of one named model: Mueller data to :mod:`~roughbrdf.fitting.polarimetric`, every
+other measurement channel by channel (or jointly, :mod:`~roughbrdf.fitting.joint`).
+
+What :func:`roughbrdf.fit` runs for a model that is not ``"auto"``, and what model choice
+(:mod:`~roughbrdf.fitting.compare`) runs for each candidate: :func:`fit_model`. Each channel is
+fitted on its own by default; ``scipy.optimize.least_squares`` (trust-region reflective, box
+bounds) minimizes the sum of squared residuals, one per sample: ``(K x - f)/f`` by default,
+whose r.m.s. is TR75's sigma (Eq. 34).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import TYPE_CHECKING, Any
+
+from ..errors import ArgumentError
+from ..models.factory import as_model, model_label
+from .data import ChannelData, prepare_channel
+from .joint import fit_joint
+from .objective import ObjectiveSpec
+from .plan import FitPlan, channel_indices, check_enough_data
+from .polarimetric import fit_mueller
+from .result import ChannelFit, FitResult
+from .search import MultiStart, SearchOptions, progress_bar
+from .threads import single_thread_blas
+
+if TYPE_CHECKING:
+    from ..measurement import Measurement
+    from ..models import Model
+    from .options import FitOptions
+
+__all__ = ["fit_model", "fit_channels", "is_mueller", "refuse_polarimetric_weight"]
+
+
+def is_mueller(measurement: Any) -> bool:
+    """Whether ``measurement`` holds Mueller elements (fitted all at once)."""
+    return getattr(measurement, "mueller", None) is not None
+
+
+def refuse_polarimetric_weight(options: FitOptions) -> None:
+    """``polarimetric_weight`` weighs normalized Mueller elements: refused for other data."""
+    if options.polarimetric_weight is not None:
+        raise ArgumentError("polarimetric_weight", "only Mueller data (measurement.mueller "
+                            "set) have normalized elements to weigh",
+                            value=options.polarimetric_weight)
+
+
+def fit_model(model: Model | str, measurement: Measurement, options: FitOptions
+              ) -> FitResult:
+    """Fit one model (an instance, a name or a spec; not ``"auto"``) with ``options``:
+    Mueller data with :func:`~roughbrdf.fitting.polarimetric.fit_mueller`, others with
+    :func:`fit_channels`."""
+    if is_mueller(measurement):  # Mueller elements: all at once
+        return fit_mueller(model, measurement, options=options)
+    refuse_polarimetric_weight(options)
+    return fit_channels(as_model(model), measurement, options)
+
+
+def fit_channels(model: Model, measurement: Measurement, options: FitOptions) -> FitResult:
+    """Fit ``model`` to the channels of ``measurement`` (not Mueller data), each on its own
+    or, with ``options.joint``, all at once."""
+    t_start = time.perf_counter()
+    chans = channel_indices(measurement, options.channel)
+    plan = FitPlan.of(model, measurement, options)
+    spec, search = plan.spec, plan.search
+    # every channel first, so that bad input fails before any work
+    data = [prepare_channel(model, measurement, j, plan.opts) for j in chans]
+    check_enough_data(measurement, data, spec.n_varys)
+    joint = options.joint
+    runs = search.starts * (1 if joint else len(chans))
+    with progress_bar(options.progress, runs, f"fit {model_label(model)}") as bar, \
+            single_thread_blas():
+        tick = None if bar is None else (lambda: bar.update(1))
+        if joint:
+            results, summary = fit_joint(spec, data, search, options.shared, tick)
+        else:
+            results, summary = _separately(spec, search, data, bar, tick), None
+    return FitResult(channels=results, **plan.result_fields(
+        measurement, time.perf_counter() - t_start, joint=summary))
+
+
+def _separately(spec: ObjectiveSpec, search: SearchOptions, data: list[ChannelData],
+                bar: Any, tick: Any) -> list[ChannelFit]:
+    """Each channel on its own, in order (the previous optimum is a warm start)."""
+    results: list[ChannelFit] = []
+    runner = MultiStart(spec, search, tick)
+    for d in data:
+        t0 = time.perf_counter()
+        if bar is not None:
+            bar.set_postfix_str(d.label)
+        obj, outcome = runner.run(d)
+        results.append(ChannelFit.from_search(obj, outcome, time.perf_counter() - t0))
+    return results

@@ -1,4 +1,8 @@
-"""Shared fixtures. Tests that need the real measurements in ../shared/data skip without them."""
+"""Shared fixtures. Tests that need the real measurements in ../shared/data skip without them.
+
+* ``shared_data``: the folder ../shared/data (``ROUGHBRDF_SHARED_DATA`` overrides it);
+* ``paints``: the three Mini-Diff paints of :data:`MINIDIFF_PAINTS`, read once per test module.
+"""
 
 from __future__ import annotations
 
@@ -8,10 +12,14 @@ from pathlib import Path
 import matplotlib
 import pytest
 
+import roughbrdf as rb
+
 matplotlib.use("Agg")  # figures are written to files; no display in CI
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED_DATA = Path(os.environ.get("ROUGHBRDF_SHARED_DATA", ROOT.parent / "shared" / "data"))
+#: the Mini-Diff paints (``minidiff/NAME.astm``) of the real-data tests: black, silver, olive drab
+MINIDIFF_PAINTS = ("C2_Black", "C8_Silver", "C12_OliveDrab")
 
 
 @pytest.fixture(scope="session")
@@ -21,3 +29,10 @@ def shared_data() -> Path:
         pytest.skip(f"real measurement data not found at {SHARED_DATA} (the ../shared folder "
                     "beside the checkout); set ROUGHBRDF_SHARED_DATA to run these tests")
     return SHARED_DATA
+
+
+@pytest.fixture(scope="module")
+def paints(shared_data: Path) -> dict[str, rb.Measurement]:
+    """``{name: Measurement}`` of the :data:`MINIDIFF_PAINTS`, read once per test module (a
+    module's tests may keep what they read); skips without ../shared/data."""
+    return {name: rb.read(shared_data / "minidiff" / f"{name}.astm") for name in MINIDIFF_PAINTS}

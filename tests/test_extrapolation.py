@@ -229,11 +229,6 @@ def test_bad_extrapolated_option_names_the_argument(bad):
 # ------------------------------------------------------------------------------------------
 # the real Mini-Diff files
 # ------------------------------------------------------------------------------------------
-@pytest.fixture(scope="module")
-def paints(shared_data):
-    return {name: rb.read(shared_data / "minidiff" / f"{name}.astm") for name in PAINTS}
-
-
 @pytest.mark.parametrize("name", PAINTS)
 def test_minidiff_tail(paints, name):
     meas = paints[name]

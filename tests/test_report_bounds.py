@@ -1,6 +1,6 @@
-"""An honest report at bounds (issue 9, part 9), the counts of starts, and how a fit is saved.
+"""An honest report at bounds, the counts of starts, and how a fit is saved.
 
-Reproduced from the issue: ``k : 5.6e-13 +/- 5.43e+05 (96289224998234226688.00%)`` (a
+Reproduced from a report once written: ``k : 5.6e-13 +/- 5.43e+05 (96289224998234226688.00%)`` (a
 parameter at a bound given a standard error and an absurd percentage), a parameter 4.9e-8 from
 a bound not flagged, and ``# starts = 9`` when 8 were asked (the previous channel's optimum
 came on top of ``starts``). Also :meth:`FitResult.save` (``overwrite=``, all-or-nothing through
@@ -54,7 +54,7 @@ def test_at_bound_rule():
     lo, hi = np.array([0.0, 0.2]), np.array([10.0, 5.0])
     assert at_bound(np.array([5.6e-13, 5.0]), lo, hi, ["k", "n"]) == {"k": "lower",
                                                                        "n": "upper"}
-    # the issue's miss: 4.9e-8 from a bound (bounds [0, 1]), within a relative 1e-6 of it
+    # the miss once reported: 4.9e-8 from a bound (bounds [0, 1]), within a relative 1e-6 of it
     assert at_bound(np.array([4.9e-8]), np.zeros(1), np.ones(1), ["x"]) == {"x": "lower"}
     assert at_bound(np.array([1 - 4.9e-8]), np.zeros(1), np.ones(1), ["x"]) == {"x": "upper"}
     assert AT_BOUND_RTOL == 1e-6
@@ -91,7 +91,7 @@ def test_fit_json_marks_the_bound(bound_fit):
     assert ch["stderr"]["g"] is None and ch["stderr"]["c"] > 0
 
 
-def test_the_issue_report_line_is_gone(bound_fit):
+def test_a_parameter_at_a_bound_has_no_stderr_in_the_report(bound_fit):
     # k : 5.6e-13 +/- 5.43e+05 (96289224998234226688.00%) -- rebuilt on a real result
     c = bound_fit.channels[0]
     fake = dataclasses.replace(
@@ -143,7 +143,7 @@ def test_starts_counted_as_asked_on_every_channel(starts):
 
 
 def test_progress_bar_total_matches_the_local_fits(monkeypatch):
-    import roughbrdf.fitting as fitting
+    import roughbrdf.fitting.channels as fitting
 
     seen = {}
 

@@ -17,7 +17,7 @@ import typer
 
 from .common import COMPARE_OPTIONS, check_channels, handled
 from .fit import read_input
-from .options import ReadInput, command, fit_options
+from .options import ReadInput, channel_labels, command, fit_options
 
 if TYPE_CHECKING:
     from ..fitting.options import FitOptions
@@ -38,7 +38,8 @@ def run_compare(file: str, models: str | None, out: str | None, options: FitOpti
     from ..output import ResultFolder
 
     meas = read_input(file, read.file_format, read.quantity, read.angles_in)
-    check_channels(meas, options.channel)  # an unknown label listed with the file's channels
+    # an unknown label listed with the file's channels
+    check_channels(meas, channel_labels(options))
     names = [n for n in FILES if plots or not n.endswith(".png")]
     if out is not None:
         ResultFolder(out, overwrite=force).check(names)

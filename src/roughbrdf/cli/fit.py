@@ -41,7 +41,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from .common import FIT_OPTIONS, angle_names, check_channels, cli_model, handled, parse_params
-from .options import ModelInput, ReadInput, command, fit_options
+from .options import ModelInput, ReadInput, channel_labels, command, fit_options
 
 if TYPE_CHECKING:
     from ..fitting.options import FitOptions
@@ -238,7 +238,7 @@ def run_fit(file: str, out: str, given: ModelInput, options: FitOptions, read: R
 
     m, options = resolve_model(given, options)
     meas = read_input(file, read.file_format, read.quantity, read.angles_in)
-    chans = None if options.channel is None else [str(c) for c in options.channel]
+    chans = channel_labels(options)
     ResultFolder(out, overwrite=force).check(result_names(meas, chans, plots, given.auto))
     if given.auto:
         res = fit_auto(meas, given.models, cv=cv, options=options)

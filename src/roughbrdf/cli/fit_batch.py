@@ -76,12 +76,15 @@ def check_search(starts: int, loss: str, seed: int, relative_to: str | None = No
     ...
     ValueError: --starts must be >= 1 (got 0)
     """
-    from ..quantity import LOSSES, Quantity
+    from ..quantity import LOSSES, Loss, Quantity
 
     if starts < 1:
         raise ValueError(f"--starts must be >= 1 (got {starts})")
-    if loss not in LOSSES:
-        raise ValueError(f"--loss: unknown value {loss!r} (choose from {', '.join(LOSSES)})")
+    try:  # the loss's own check, worded for the command line
+        Loss.parse(loss)
+    except ValueError:
+        raise ValueError(f"--loss: unknown value {loss!r} (choose from "
+                         f"{', '.join(LOSSES)})") from None
     if seed < 0:  # numpy's generators take no negative seed
         raise ValueError(f"--seed must be >= 0 (got {seed})")
     if relative_to is not None:

@@ -23,8 +23,8 @@ import typer
 if TYPE_CHECKING:
     from ..fitting.options import FitOptions
 
-__all__ = ["TABLE", "ModelInput", "ReadInput", "command", "fit_options", "check_aperture",
-           "fit_domain"]
+__all__ = ["TABLE", "ModelInput", "ReadInput", "channel_labels", "check_aperture", "command",
+           "fit_domain", "fit_options"]
 
 # the options of model choice, joint fits and the fit domain, shared with `roughbrdf compare`
 ModelsOption = Annotated[str | None, typer.Option(
@@ -154,6 +154,14 @@ def fit_options(values: Mapping[str, Any], *, progress: bool | None = None) -> F
                       theta_r_max=t_max, source_exclusion=excl,
                       extrapolated="keep" if values.get("keep_extrapolated") else "drop",
                       progress=progress)
+
+
+def channel_labels(options: FitOptions) -> list[str] | None:
+    """The ``--channel`` values of ``options`` as the command line gave them (text), or None."""
+    chosen = options.channel
+    if chosen is None:
+        return None
+    return [str(c) for c in (chosen if isinstance(chosen, list | tuple) else [chosen])]
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""Directional-hemispherical reflectance ``rb.albedo`` (issue: accurate to 1e-4, also for e=0.05).
+"""Directional-hemispherical reflectance ``rb.albedo``: accurate to 1e-4, also for e=0.05.
 
 Oracles: the exact value 1/(1 + e^2) for the microfacet Trowbridge-Reitz model with F = 1 and
 no shadowing at normal incidence (docs/models.md §3.7: the fraction of micro-area with
@@ -92,7 +92,7 @@ def test_lambertian_exact_everywhere():
     t = np.radians(np.array([0.0, 10, 45, 80]))
     np.testing.assert_allclose(rb.albedo(lam, t), 0.37, atol=1e-12)
     # at grazing incidence the specular direction, the centre of the quadrature, lies on the
-    # horizon; still well inside the 1e-4 of the issue
+    # horizon; still well inside the required 1e-4
     np.testing.assert_allclose(rb.albedo(lam, np.radians([89.9, 90.0])), 0.37, atol=2e-5)
 
 

@@ -1,6 +1,6 @@
-"""Traps in the Python API closed (issue 9, part 8) and the library side of its part 7.
+"""Traps in the Python API, closed, and the library side of messages in the user's terms.
 
-Each problem the issue lists under "Why" for these parts is reproduced here:
+Each trap is reproduced here:
 
 * ``m.params['e'] = 0.1`` and ``m.e = -1`` silently did nothing: now they raise, naming
   ``with_params`` (models are immutable values: ``Model``'s docstring says why);
@@ -73,7 +73,7 @@ def test_attribute_named_like_a_parameter_or_option_raises(name):
             setattr(m, attr, {})
 
 
-def test_the_issue_examples():
+def test_assigning_a_parameter_raises_naming_with_params():
     m = rb.model("trowbridge-reitz-1975", e=0.68)
     with pytest.raises(TypeError, match=r"with_params\(e=\.\.\.\)"):
         m.params["e"] = 0.1
@@ -348,7 +348,7 @@ def test_hypothesis_bad_fit_options_raise_naming_the_option(data, option):
 
 
 # ---------------------------------------------------------------------------------------------
-# part 7, library side: ArgumentError worded for Python by str, for the CLI by render
+# messages, library side: ArgumentError worded for Python by str, for the CLI by render
 # ---------------------------------------------------------------------------------------------
 CLI = {"negative": "--negative", "nonfinite": "--nonfinite", "bounds": "--bounds",
        "aperture": "--aperture", "starts": "--starts"}

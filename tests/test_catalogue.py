@@ -1,4 +1,4 @@
-"""Catalogues (issue 12, part 1): ``rb.fit_catalogue`` and ``roughbrdf fit-batch`` on real
+"""Catalogues: ``rb.fit_catalogue`` and ``roughbrdf fit-batch`` on real
 ``dask.distributed`` clusters: a ``LocalCluster`` of 2 worker processes started by the call, and
 an existing cluster reached by its scheduler address.
 """

@@ -1,4 +1,4 @@
-"""The local cluster of ``fit-batch`` (issue "Safe edges, second pass", findings 5, 6 and 7):
+"""The local cluster of ``fit-batch``, closed to others and quiet:
 a second local client without the cluster's credentials is refused, no HTTP port listens, the
 workers' profiler is off, Ctrl-C at the start is quiet (one line, exit 130), and a bad option
 exits 2 naming the CLI option before any cluster starts. Real ``dask.distributed`` clusters of

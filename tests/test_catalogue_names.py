@@ -1,4 +1,4 @@
-"""Catalogue fit folder names (issue "Safe edges, second pass", finding 2): every input's fit
+"""Catalogue fit folder names: every input's fit
 folder lies inside ``--out``, is distinct from the others (also case-insensitively) and is
 never one of the catalogue's own files, whatever the inputs' names; ordinary names are kept.
 Run on a real ``dask.distributed`` LocalCluster of worker processes.

@@ -1,4 +1,4 @@
-"""The catalogue summary page (issue 12): files, contents, escaping, size, and a real browser.
+"""The catalogue summary page: files, contents, escaping, size, and a real browser.
 
 The browser tests open ``summary.html`` in Debian's Chromium, driven by selenium through the
 system chromedriver (``/usr/bin/chromedriver``, passed explicitly: selenium's manager never
@@ -262,3 +262,20 @@ def test_browser_hundred_thousand_rows(browser: Any, tmp_path: Path) -> None:
     assert vals[0] == pytest.approx(smallest, rel=1e-3), (vals[0], smallest)
     assert len(browser.find_elements("css selector", "#rb-table tbody tr")) == 100
     assert _severe(browser) == []
+
+
+# --------------------------------------------------------------------------------------------
+# the page's style sheet and script are the package's asset files, inlined as they are
+# --------------------------------------------------------------------------------------------
+
+def test_page_inlines_the_asset_files(tmp_path: Path) -> None:
+    from importlib import resources
+
+    assets = resources.files("roughbrdf.catalogue").joinpath("assets")
+    css = assets.joinpath("summary.css").read_text(encoding="utf-8")
+    js = assets.joinpath("summary.js").read_text(encoding="utf-8")
+    page = write_summary(tmp_path, make_rows(6))[1].read_text(encoding="utf-8")
+    style = re.findall(r"<style>\n(.*?)</style>", page, re.S)
+    scripts = re.findall(r"<script>\n(.*?)</script>", page, re.S)
+    assert style == [css] and scripts == [js]
+    assert "aria-sort" in css and 'document.body.dataset.ready = "1"' in js

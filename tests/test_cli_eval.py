@@ -94,7 +94,7 @@ def test_eval_horizon_gives_inf_for_unshadowed_tr75():
     (["eval", "tr75", "-p", "e=-1"], ["'e'", "-1.0"]),
     (["eval", "tr75", "-p", "k=-0.5"], ["'k'", "-0.5"]),
     (["eval", "ts67", "-p", "c=0"], ["'c'", "0.0"]),
-    # angles are named as the options and shown in degrees (issue 9, part 7)
+    # angles are named as the options and shown in degrees
     (["eval", "tr75", "--theta-i", "90"], ["--theta-i 90 (degrees)"]),
     (["eval", "tr75", "--theta-r", "95"], ["--theta-r 95 (degrees)"]),
     (["eval", "microfacet", "-p", "distribution=bekmann"], ["did you mean 'beckmann'"]),

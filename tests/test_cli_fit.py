@@ -120,7 +120,7 @@ def test_never_overwrites_foreign_files(tmp_path):
     res = _fit(*args)
     assert res.exit_code == 2 and "not overwriting fit.json" in res.output
     assert (out / "fit.json").read_text() == "{}"
-    # issue 9: a file roughbrdf did not write is never replaced, not even with --force
+    # a file roughbrdf did not write is never replaced, not even with --force
     res = _fit(*args, "--force")
     assert res.exit_code == 2 and "not overwriting fit.json" in res.output
     assert "not even with --force" in res.output
@@ -190,7 +190,7 @@ def test_free_scale_option_fits_a_data_scale_on_absolute_data(tmp_path):
 
 
 # ---------------------------------------------------------------------------------------------
-# issue 9: CLI options for what the library takes (part 7), refusing before the fit (part 1)
+# CLI options for what the library takes, refusing before the fit
 # ---------------------------------------------------------------------------------------------
 def test_bounds_option(tmp_path):
     out = tmp_path / "b"
@@ -288,7 +288,7 @@ def test_result_names_are_the_names_save_writes(tmp_path):
 
 
 def test_force_replaces_the_whole_earlier_set(tmp_path):
-    """issue 9: a second fit (another model, no plots) replaced fit.json and report.txt without a
+    """A second fit (another model, no plots) once replaced fit.json and report.txt without a
     word and left the old PNG beside them; now it asks for --force, which replaces the set."""
     out = tmp_path / "o"
     res = _fit(DEFAULT, "-m", "tr75", "--starts", "1", "-q", "--out", out)

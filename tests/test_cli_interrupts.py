@@ -1,4 +1,4 @@
-"""Ctrl-C as the command line ends (issue "Safe edges, second pass", finding 8).
+"""Ctrl-C as the command line ends.
 
 A SIGINT that arrives once ``roughbrdf.cli.main``'s run has returned must not escape ``main`` as
 ``KeyboardInterrupt`` (a traceback, death by signal): the work is done and committed, so

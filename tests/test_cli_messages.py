@@ -1,4 +1,4 @@
-"""CLI messages in the terms of the verb used (issue "Safe edges, second pass", finding 7):
+"""CLI messages in the terms of the verb used:
 one line on stderr naming the option and the value, exit 2, never an internal error.
 
 Each test runs ``roughbrdf.cli.main([...])`` as a user would and reads stderr with ``capsys``.

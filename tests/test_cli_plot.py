@@ -164,7 +164,7 @@ def test_plot_fit_errors(tmp_path):
 
 
 # ---------------------------------------------------------------------------------------------
-# issue 9: --fit DIR from any folder, a changed input, the fit's set (parts 1, 7)
+# --fit DIR from any folder, a changed input, the fit's set
 # ---------------------------------------------------------------------------------------------
 def _sha(path) -> str:
     import hashlib

@@ -1,4 +1,4 @@
-"""The command line at its edges (issue 9, parts 1-4): Ctrl-C at any moment, two runs at once,
+"""The command line at its edges: Ctrl-C at any moment, two runs at once,
 errors of the operating system, and the exit statuses of ``roughbrdf`` (``roughbrdf.cli``).
 
 Times printed by the signal test (``pytest -s``) are figures for the docs, not assertions.
@@ -72,7 +72,7 @@ def _finish(p: subprocess.Popen) -> tuple[str, str]:
 
 
 # ---------------------------------------------------------------------------------------------
-# Ctrl-C (part 3)
+# Ctrl-C
 # ---------------------------------------------------------------------------------------------
 @pytest.mark.slow
 def test_ctrl_c_at_any_moment_of_a_fit_leaves_old_or_new_results(tmp_path):
@@ -220,7 +220,7 @@ tqdm.std.tqdm.update = update
 
 
 def test_ctrl_c_swallowed_by_a_library_still_ends_the_run(old_result):
-    """The issue's Numba case: a KeyboardInterrupt raised where Python can only print
+    """Numba's case: a KeyboardInterrupt raised where Python can only print
     "Exception ignored" (a C callback, a finalizer) must still stop the run, before it writes."""
     prelude = """
 import os, signal
@@ -243,7 +243,7 @@ _fitting.fit = fit
 
 
 # ---------------------------------------------------------------------------------------------
-# one run at a time, all or nothing (parts 1, 2)
+# one run at a time, all or nothing
 # ---------------------------------------------------------------------------------------------
 @pytest.mark.slow
 def test_two_runs_into_one_folder_at_once(tmp_path):
@@ -296,7 +296,7 @@ def _must_not_fit(*args, **kwargs):
 
 
 # ---------------------------------------------------------------------------------------------
-# errors of the operating system (part 4) and exit statuses
+# errors of the operating system and exit statuses
 # ---------------------------------------------------------------------------------------------
 def _cli(*args):
     return runner.invoke(app, [str(a) for a in args])

@@ -1,4 +1,4 @@
-"""Degrees everywhere at the CLI (issue "Safe edges, second pass", finding 7): model parameters
+"""Degrees everywhere at the CLI: model parameters
 whose unit is an angle (Oren-Nayar ``sigma``, alone, in ``coated(diffuse="oren-nayar")`` and in
 sums) and the polarization angle are taken and printed in degrees; ``fit.json`` and the Python
 API keep radians."""

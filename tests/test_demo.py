@@ -64,7 +64,7 @@ def test_demo_refuses_foreign_files(tmp_path):
 
 
 def test_demo_refuses_earlier_results_before_any_work(tmp_path, monkeypatch, capsys):
-    """issue 9: `make demo` passes --force for its own out/; without it an earlier result stops
+    """`make demo` passes --force for its own out/; without it an earlier result stops
     the run before it computes anything, with one line and exit status 2."""
     from roughbrdf.output import ResultFolder
 

@@ -64,7 +64,7 @@ def test_tis_is_the_directional_hemispherical_reflectance(exported, name):
 
 @pytest.mark.parametrize("name", MODELS)
 def test_table_integral_agrees_with_tis(exported, name):
-    """The issue asks for 1e-2; the default grid gives 1.3e-3 for these models (worst: TR75
+    """1e-2 is required; the default grid gives 1.3e-3 for these models (worst: TR75
     at normal incidence, the coated and GGX 0.05 lobes cut by the horizon at 80 deg)."""
     _, f = exported[name]
     table = read_table(f.path)

@@ -1,4 +1,4 @@
-"""Nonsense that must not succeed (issue "Safe edges, second pass", finding 7): a fit of data
+"""Nonsense that must not succeed: a fit of data
 with no positive value is refused, naming the channel, in Python and at the CLI."""
 
 from __future__ import annotations

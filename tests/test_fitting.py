@@ -416,7 +416,7 @@ def test_plot_and_save(two_channel_fit, tmp_path):
     written = two_channel_fit.save(tmp_path / "out")
     names = sorted(p.name for p in written)
     assert names == ["fit.json", "fit_blue.png", "fit_red.png", "report.txt"]
-    # an earlier run's results are replaced only when asked (issue 9, part 1); the new set
+    # an earlier run's results are replaced only when asked; the new set
     # replaces the old one exactly (the stale PNGs go)
     two_channel_fit.save(tmp_path / "out", plots=False, overwrite=True)
     assert sorted(p.name for p in (tmp_path / "out").iterdir()

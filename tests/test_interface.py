@@ -77,7 +77,7 @@ def test_bad_polarization_names_the_value(bad, match):
 
 
 def test_stokes_and_analyzer_are_used_not_ignored():
-    # issue 13: the reserved fields are implemented (tests/test_stokes.py); where a path has no
+    # the Stokes fields are evaluated (tests/test_stokes.py); where a path has no
     # Stokes evaluation (prepare: the scalar kernels) they are refused, never dropped
     pol = Polarization(np.asarray(np.nan), stokes=(1.0, 0.0, 0.0, 0.0),
                        analyzer=(0.5, 0.5, 0.0, 0.0))

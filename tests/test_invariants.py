@@ -64,7 +64,7 @@ def _ti_max(m) -> float:
     return HALF_PI if m.grazing_incidence else np.nextafter(HALF_PI, 0.0)
 
 
-def test_every_issue_model_is_registered():
+def test_the_core_models_are_registered():
     for name in ["lambertian", "microfacet", "torrance-sparrow-1967", "trowbridge-reitz-1975"]:
         assert name in rb.available()
 

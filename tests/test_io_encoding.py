@@ -1,4 +1,4 @@
-"""Issue "Safe edges, second pass", reader part of finding 7: what the text readers do with the
+"""What the text readers do with the
 bytes of a file.
 
 * A UTF-16 or UTF-32 file with a byte-order mark is read (decoded as such); one without a mark

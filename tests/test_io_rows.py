@@ -1,4 +1,4 @@
-"""Issue "Safe edges, second pass", finding 3 and the reader parts of 7: the rows of the text
+"""The rows of the text
 readers are read row by row, never shifted, and the angles' unit is checked for plausibility.
 
 * An empty field in one row and a number with a blank inside in a later row used to cancel
@@ -69,7 +69,7 @@ def _with_field(fmt: str, row: int, col: int, text: str) -> list[str]:
 
 
 # ------------------------------------------------------------------------------------------
-# finding 3: an empty field and a later inner-blank field never shift the rows between them
+# an empty field and a later inner-blank field never shift the rows between them
 # ------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("fmt", ["csv", "astm"])
 def test_empty_field_then_inner_blank_is_refused_at_the_first_bad_line(tmp_path, fmt):
@@ -111,7 +111,7 @@ def test_blank_separated_rows_with_a_missing_and_an_extra_value_name_the_first(t
 
 
 # ------------------------------------------------------------------------------------------
-# finding 7: numbers that float() reads but a measurement file must not hold
+# numbers that float() reads but a measurement file must not hold
 # ------------------------------------------------------------------------------------------
 BAD_NUMBERS = [("1_5", r"'_' in the field '1_5'"),
                ("１５", r"non-ASCII characters U\+FF11, U\+FF15 in the field '１５'"),
@@ -186,7 +186,7 @@ def test_plain_numbers_still_read(tmp_path, fmt):
 
 
 # ------------------------------------------------------------------------------------------
-# finding 7: the angles' unit is plausible, or a warning says so
+# the angles' unit is plausible, or a warning says so
 # ------------------------------------------------------------------------------------------
 def test_radians_file_read_in_degrees_warns(tmp_path):
     """Why: an ASTM file in radians read with ``angles="deg"`` (every angle below 1.6 deg) was

@@ -1,4 +1,4 @@
-"""Issue 9, parts 1 (library writers), 5 and 6: nothing a user has is lost.
+"""The library's writers and readers: nothing a user has is lost.
 
 * writers never replace an existing file unless ``overwrite=True``, never write onto the
   measurement's own input, and write atomically (no partial or 0-byte file on error or Ctrl-C);
@@ -9,7 +9,7 @@
   ``quantity=``/``angles=`` that contradicts the file raises in every reader; a file cut inside
   its last number gets a warning naming the line.
 
-Each "Why" problem of these parts is reproduced here (it failed before the change).
+Each problem is reproduced here (each test failed before the change).
 """
 
 from __future__ import annotations
@@ -110,7 +110,7 @@ def _leftovers(folder: Path) -> list[str]:
 
 
 # ------------------------------------------------------------------------------------------
-# part 1: writers never overwrite without asking, never write onto their input, atomically
+# writers never overwrite without asking, never write onto their input, atomically
 # ------------------------------------------------------------------------------------------
 FORMATS = [("astm", ".astm"), ("alta", ".dat"), ("csv", ".csv"), ("merl", ".binary")]
 
@@ -196,7 +196,7 @@ def test_merl_write_table_is_atomic_and_refuses(tmp_path):
 
 
 # ------------------------------------------------------------------------------------------
-# part 5: conversions tell the truth or refuse
+# conversions tell the truth or refuse
 # ------------------------------------------------------------------------------------------
 def test_minidiff_to_merl_refuses_then_reports_exactly(shared_data, tmp_path):
     """Why: converting a Mini-Diff .astm to MERL said all 12,964 samples and the negative values
@@ -411,7 +411,7 @@ def test_writers_refuse_what_they_cannot_hold(tmp_path):
 
 
 # ------------------------------------------------------------------------------------------
-# part 6: readers
+# readers
 # ------------------------------------------------------------------------------------------
 def _both_lines(exc: FormatError, first: int, second: int) -> None:
     assert exc.line == second

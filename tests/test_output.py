@@ -1,6 +1,5 @@
 """``roughbrdf.output`` and ``roughbrdf.interrupts``: no overwrite unless asked, all-or-nothing
-result sets, one run at a time, and Ctrl-C that is deferred or re-raised, never lost
-(issue 9, parts 1-3)."""
+result sets, one run at a time, and Ctrl-C that is deferred or re-raised, never lost."""
 
 from __future__ import annotations
 

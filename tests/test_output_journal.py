@@ -1,4 +1,4 @@
-"""A process killed at any instant of a commit (issue "Safe edges, second pass", finding 4).
+"""A process killed at any instant of a commit.
 
 The kill is injected, not timed: a subprocess replaces ``os.replace`` by a wrapper that calls
 ``os._exit(9)`` at its k-th call, for every k of a commit (the journal's write is the first

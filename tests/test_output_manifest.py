@@ -1,8 +1,7 @@
-"""A results folder's manifest is trusted only as far as it is roughbrdf's (issue "Safe edges,
-second pass", finding 1): names outside the folder, a symbolic link for a manifest, a manifest
-that is no list of names, a listed name that is a link out of the folder are refused naming
-the manifest, and never acted upon; a listed file the user changed since is refused by
-``--force`` naming it (never replaced, never removed).
+"""A results folder's manifest is trusted only as far as it is roughbrdf's: names outside the
+folder, a symbolic link for a manifest, a manifest that is no list of names, a listed name that
+is a link out of the folder are refused naming the manifest, and never acted upon; a listed
+file the user changed since is refused by ``--force`` naming it (never replaced, never removed).
 """
 
 from __future__ import annotations

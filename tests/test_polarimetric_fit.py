@@ -1,4 +1,4 @@
-"""Polarimetric data (issue 13 part 3): Mueller elements in a Measurement, in CSV, and rb.fit.
+"""Polarimetric data: Mueller elements in a Measurement, in CSV, and rb.fit.
 
 The acceptance test: synthetic Mueller data of a rough metal (microfacet, Beckmann alpha = 0.3,
 n + ik = 0.2 + 3i) with noise. Its unpolarized BRDF hardly tells n from k: a second index with the

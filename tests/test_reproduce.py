@@ -4,7 +4,7 @@ Targets and their sources (all in docs/models.md):
 * TS67 Fig. 7 table, back peaks, Fig. 8 peaks and finer rows, Figs. 10/11 phi row: §2.7;
 * TS67 Fig. 9 with the specification's placeholder indices (MgO 1.74, Al 0.77 + 6.08i): §2.7;
 * TR75 Fig. 5 HWHMs: §3.11; Table 1 DHRs: §3.10; cement sample BRIDFs: §3.12.
-Tolerances follow the core issue: Fig. 7 rows 1e-3, DHRs ±0.002, HWHMs 0.05°.
+Tolerances: Fig. 7 rows 1e-3, DHRs ±0.002, HWHMs 0.05°.
 """
 
 from __future__ import annotations
@@ -334,7 +334,7 @@ def _fake(name, value):
 
 
 def test_run_writes_one_set_and_replaces_it_only_with_overwrite(tmp_path, monkeypatch):
-    """issue 9: the folder holds one run's results; a failure midway leaves them as they were."""
+    """The folder holds one run's results; a failure midway leaves them as they were."""
     import roughbrdf.reproduce as rp
     from roughbrdf.output import MANIFEST, OverwriteRefused
 

@@ -1,4 +1,4 @@
-"""Stokes vectors in and out (issue 13 part 2): roughbrdf.stokes and Polarization(stokes=,
+"""Stokes vectors in and out: roughbrdf.stokes and Polarization(stokes=,
 analyzer=).
 
 Conventions are those written in src/roughbrdf/mueller.py (SCATMECH's): Q > 0 is s, TR75's gamma

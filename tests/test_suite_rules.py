@@ -1,7 +1,7 @@
 """Rules of the suite itself: no test asserts on elapsed time.
 
 A time taken depends on the machine and its load, so an assertion on it fails on a loaded
-machine without anything being wrong (issue "Safe edges, second pass", finding 8). A test
+machine without anything being wrong. A test
 asserts on what the time stood for (a page that is paged, rows parsed in one block); speed
 figures belong to ``benchmarks/`` (``benchmarks/bench_suite_figures.py``).
 

@@ -47,8 +47,17 @@ VERBS = ["evaluate", "fit", "fit_batch", "compare", "export", "convert", "plot",
 _APP: list[Any] = []
 
 
-class _Run:
-    """State of the current command line run (set by the verbs, read by :func:`main`)."""
+class Run:
+    """State of the current command line run: set by :func:`main` and the verbs
+    (:mod:`roughbrdf.cli.common` records a reported interrupt), read by :func:`main`.
+
+    Attributes
+    ----------
+    debug : bool
+        ``--debug`` was given: errors also show their traceback.
+    interrupt_reported : bool
+        ``interrupted`` has been printed for this run (printed once).
+    """
 
     debug = False
     interrupt_reported = False
@@ -67,8 +76,8 @@ def build_app() -> typer.Typer:
     @new.callback()
     def _options(debug: bool = typer.Option(
             False, "--debug", help="on an error, also show the traceback")) -> None:
-        _Run.debug = debug
-        _Run.interrupt_reported = False
+        Run.debug = debug
+        Run.interrupt_reported = False
 
     for name in VERBS:
         try:
@@ -108,8 +117,8 @@ def main(argv: list[str] | None = None) -> int:
     """
     from ..interrupts import checkpoint, record_interrupts, watch
 
-    _Run.debug = "--debug" in (sys.argv[1:] if argv is None else argv)  # until parsed
-    _Run.interrupt_reported = False
+    Run.debug = "--debug" in (sys.argv[1:] if argv is None else argv)  # until parsed
+    Run.interrupt_reported = False
     with watch():
         try:
             code = _run(argv)  # returns with SIGINT recorded, never raised
@@ -117,10 +126,10 @@ def main(argv: list[str] | None = None) -> int:
             code = EXIT_INTERRUPTED
             record_interrupts()
         checkpoint("main: status settled")
-        if code == EXIT_INTERRUPTED and not _Run.interrupt_reported:
+        if code == EXIT_INTERRUPTED and not Run.interrupt_reported:
             _say("interrupted")
             checkpoint("main: interrupted said")
-            _Run.interrupt_reported = True
+            Run.interrupt_reported = True
         checkpoint("main: reported")
         if argv is None:
             _ignore_sigint()
@@ -164,7 +173,7 @@ def _invoke(argv: list[str] | None) -> int:
     except Exception as exc:  # not handled by a verb: a bug
         import traceback
 
-        if _Run.debug:
+        if Run.debug:
             traceback.print_exception(exc, file=sys.stderr)
         _say(f"error: internal error: {type(exc).__name__}: {exc} (a bug in roughbrdf; "
              f"`roughbrdf --debug ...` shows the traceback)")

@@ -28,7 +28,8 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from . import EXIT_BUG, EXIT_INTERRUPTED, EXIT_OS, EXIT_USAGE, _Run
+from . import EXIT_BUG, EXIT_INTERRUPTED, EXIT_OS, EXIT_USAGE
+from . import Run as _Run
 
 if TYPE_CHECKING:
     import numpy as np

@@ -1,7 +1,8 @@
 """Coated materials and rough diffuse reflection (docs/models.md §10).
 
 The new terms are tested the way the published models are (tests/test_invariants.py,
-tests/test_models_core.py, tests/test_albedo.py). Where the expected numbers come from:
+tests/test_ts67.py, tests/test_tr75.py, tests/test_albedo.py). Where the expected numbers come
+from:
 
 * hemispherical Fresnel reflectance ``F_dr`` (§10.1): a composite Gauss-Legendre quadrature of
   ``rb.fresnel.reflectance`` written here (total internal reflection exact: ``R = 1`` below the

@@ -3,11 +3,11 @@
 I. G. E. Renhorn and G. D. Boreman, "Analytical fitting model for rough-surface BRDF",
 Opt. Express 16(17), 12892-12898 (2008). Targets: docs/models.md §4.14.
 
-The paper's fitted parameter values and its measured data are not available (seed ``004_...``
-has the abstract, the three figure captions and flattened equations only). The figures use
-:data:`PARAMS`, the 14 parameters fitted by ``rb.fit`` to the CEA gray tape with the option
-``retro_shadowing="amplitude"`` (see :data:`CEA_GRAY_TAPE`, :data:`OPTIONS`); :data:`PLAUSIBLE`
-is the hand-chosen set used before any fit existed.
+The paper's fitted parameter values and its measured data are not available (the text of the
+paper at hand has the abstract, the three figure captions and flattened equations only). The
+figures use :data:`PARAMS`, the 14 parameters fitted by ``rb.fit`` to the CEA gray tape with the
+option ``retro_shadowing="amplitude"`` (see :data:`CEA_GRAY_TAPE`, :data:`OPTIONS`);
+:data:`PLAUSIBLE` is the hand-chosen set used before any fit existed.
 What can be checked without the paper: Vm's identities (§4.8) and the claim that the model spans
 two orders of magnitude of BRDF over a range of incidences (§4.14).
 """
@@ -241,7 +241,7 @@ def fig3(params: dict | None = None, data_dir: str | Path | None = None) -> Repr
         "rb08_fig03", "RB08 Fig. 3: rough-surface BRDF against in-plane scattering angle", fig,
         tables,
         notes=[f"Parameters: {_source(params)}; the paper's fitted values are not published "
-               "in the seed.",
+               "in the copy of the paper we work from.",
                f"Model options: {m.options}."])
 
 

@@ -130,8 +130,8 @@ def fig5() -> Reproduction:
         {"curves": Table(["alpha_deg", *(nm for _, nm, _, _ in STRUCTURE_FUNCTIONS),
                           "sirohi_p4"], curve_rows),
          "hwhm": Table(["function", "distribution", "parameter", "caption", "hwhm_deg"], rows)},
-        notes=["Rense's measured points are not in the seeds, so only the fitted curves are "
-               "drawn."])
+        notes=["Rense's measured points are not available as numbers, so only the fitted "
+               "curves are drawn."])
 
 
 # --------------------------------------------------------------------------------------------
@@ -187,9 +187,9 @@ def fig6(columns: tuple[tuple[float, float], ...] = FIG6_COLUMNS) -> Reproductio
                           "bridf_par", "bridf_unpolarized"], rows),
          "checks": Table(["surface", "beta_deg", "elevation_deg", "psi_deg",
                           "bridf_unpolarized"], checks)},
-        notes=["The measured points of the paper's Fig. 6 are not in the seeds and its column "
-               "headings are illegible; we draw the model for three (β, θ) pairs from the "
-               "paper's measurement grid."])
+        notes=["The measured points of the paper's Fig. 6 are not available as numbers and "
+               "its column headings are illegible; we draw the model for three (β, θ) pairs "
+               "from the paper's measurement grid."])
 
 
 # --------------------------------------------------------------------------------------------

@@ -243,10 +243,12 @@ def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model
                              options=options)
     files = expand_inputs(inputs)
     out = Path(out_dir)
-    # the fingerprint of --resume: the options that differ from the defaults
-    changed = {k: v for k, v in fit_opts.changed().items() if k != "progress"}
-    opts = {"fit": changed, "read": dict(read_options or {}), "plots": plots,
-            "candidates": candidates, "cv": cv}
+    # the fingerprint of --resume: the options of `options` that differ from the defaults and
+    # the keywords as given (a keyword call fingerprints as it did before FitOptions existed)
+    given = {**({} if options is None else options.changed()), **fit_options}
+    opts = {"fit": {k: v for k, v in given.items() if k != "progress"},
+            "read": dict(read_options or {}), "plots": plots, "candidates": candidates,
+            "cv": cv}
     fp = fingerprint(model, opts)
     label = _label(model)
     tasks, kept = [], {}

@@ -25,8 +25,7 @@ retro pair multiplies the strength instead of the width::
     BRDF_retro = (1 - sigma_s) retro N(alpha0, rho_r) V(alpha0, w_r, n_r) V(sin theta_s, w_r, n_r)
                  / [(alpha + alpha0)^2 + beta^2 + (ci + cs)^2/4 rho_r^2]
 
-
-Layout:
+Layout (the kernels, their speeds and how they agree are described in ``kernel``):
 
 * :mod:`~roughbrdf.models.renhorn_boreman.kernel` -- the compiled kernel: packed parameters,
   scalar parts (Eqs. 6/8 N, 15, 19, 20), the fast, tabulated and general drivers;

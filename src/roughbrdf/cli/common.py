@@ -28,8 +28,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from . import EXIT_BUG, EXIT_INTERRUPTED, EXIT_OS, EXIT_USAGE
-from . import Run as _Run
+from . import EXIT_BUG, EXIT_INTERRUPTED, EXIT_OS, EXIT_USAGE, Run
 
 if TYPE_CHECKING:
     import numpy as np
@@ -109,7 +108,7 @@ def handled(options: Mapping[str, str] | None = None) -> Iterator[None]:
         except _TYPER_OWN:
             raise
         except KeyboardInterrupt as exc:
-            _Run.interrupt_reported = True
+            Run.interrupt_reported = True
             typer.echo("interrupted", err=True)
             raise typer.Exit(EXIT_INTERRUPTED) from exc
         except BrokenPipeError as exc:  # stdout's reader went away (`| head`): nothing to say
@@ -117,7 +116,7 @@ def handled(options: Mapping[str, str] | None = None) -> Iterator[None]:
             raise typer.Exit(EXIT_OS) from exc
         except Exception as exc:
             code = exit_status(exc)
-            if _Run.debug:
+            if Run.debug:
                 import traceback
 
                 traceback.print_exception(exc, file=sys.stderr)

@@ -15,8 +15,8 @@ import pytest
 import roughbrdf as rb
 from roughbrdf.fitting import ChannelData, Objective, ObjectiveSpec
 from roughbrdf.fitting.data import Comparison, excluded_text
-from roughbrdf.fitting.search import MultiStart, SearchOptions, screen, sobol_points
 from roughbrdf.fitting.plan import FreeParameters
+from roughbrdf.fitting.search import MultiStart, SearchOptions, screen, sobol_points
 from roughbrdf.fitting.statistics import Covariance, GoodnessOfFit
 from roughbrdf.fitting.threads import single_thread_blas
 from roughbrdf.measurement import Measurement

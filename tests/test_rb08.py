@@ -378,7 +378,7 @@ def minidiff_like_geometry():
 def test_tabulated_kernel_equals_general_kernel(opts, monkeypatch):
     # Real n (and the numeric N) run the tabulated kernel: V once per distinct angle through
     # a memo, then the vectorized loop. The reference is the general kernel, which computes V
-    # per sample and ran every such evaluation until 2026-12: the same numbers (bit for bit
+    # per sample: the same numbers (bit for bit
     # on the data measured; 1e-13 allows for FMA contraction).
     used = []
     run = rbk._kernels.run_driver

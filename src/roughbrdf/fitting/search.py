@@ -6,8 +6,7 @@ model's own values, one from the previous channel's optimum when there is one an
 2`` (a warm start), and the rest from scrambled Sobol points (:func:`sobol_points`) in the bounds
 of the free parameters, chosen by :func:`screen` among ``screen`` candidates (one model
 evaluation each: the lowest cost, kept at least :data:`SCREEN_DIST` of the bounds apart).
-(Until 2026-11 the warm start came on top of ``starts``: a report of a second channel said
-``# starts = 9`` when 8 were asked.) When a channel has more than ``subsample``
+When a channel has more than ``subsample``
 samples, the local fits explore a fixed random subsample (loose tolerance
 :data:`EXPLORE_TOL`: they only need to find the basin) and the ``polish`` best distinct end
 points are refined on all samples (:func:`polish_fit`, :data:`POLISH_TOL`); the best is the

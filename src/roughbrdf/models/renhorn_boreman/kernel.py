@@ -19,8 +19,7 @@ Kernels (all compiled with Numba, parallel over samples):
   ``V(sin theta_i)``, ``V(sin theta_s)`` per sample through a small memo keyed on the angle
   (a fit's data repeat a few dozen angles), then the vectorized loop of the fast kernel reads
   them. Measured on a Mini-Diff channel (10,804 geometries, 4 incidences, 76 reflection
-  angles; 2 cores): 0.27 ms per evaluation, against 1.6 ms for the general kernel (which,
-  until 2026-12, ran every fit with non-integer n: over 80 % of a 14-parameter fit's time).
+  angles; 2 cores): 0.27 ms per evaluation, against 1.6 ms for the general kernel.
 * **general** (per-sample polarization, and
   :meth:`~roughbrdf.models.renhorn_boreman.RenhornBoreman2008.with_general_kernel`, the
   reference): the incomplete gamma per sample (loops: not vectorized); the

@@ -168,11 +168,7 @@ def lobe_integral(theta_i, rho: float, w: float, n: float) -> np.ndarray:
     ~300-6000 integrand evaluations, ~0.02 ms per incidence. Relative accuracy against a
     16x finer quadrature: <= 2e-11 up to 89.99 deg (rho 0.005-2, w 0.05-2, n 0-50, tested),
     ~1e-7 within 1e-4 deg of grazing (where ``1 - sin theta`` itself loses the digits).
-
-    (Until 2026-12 this was a 2-D quadrature about the peak, ~3 ms per incidence, which made
-    a numeric-N fit of one Mini-Diff channel take over a minute; it erred by up to 6e-3 where
-    V turns over within a few of its nodes (w ~0.05, n ~50) and returned NaN or inf where
-    ``V(sin theta_i)`` is below ~1e-150; the kernel then fell back to the literal N.)
+    (What it replaced, and why: CHANGELOG, "History of the numerical changes".)
     """
     ti = np.asarray(theta_i, dtype=np.float64)
     a = 1.0 + n

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from .common import COMPARE_OPTIONS, check_channels, handled
-from .fit import read_input
+from .fit import echo_untrusted, energy_warnings, read_input
 from .options import ReadInput, channel_labels, command, fit_options
 
 if TYPE_CHECKING:
@@ -32,7 +32,8 @@ FILES = ("compare.md", "compare.json", "compare.png")
 def run_compare(file: str, models: str | None, out: str | None, options: FitOptions,
                 read: ReadInput, *, force: bool, plots: bool, cv: bool) -> int:
     """The work of ``roughbrdf compare``; returns the exit status (0, or 1 if a candidate's fit
-    did not converge)."""
+    did not converge, or the best candidate (lowest BIC) has a parameter on a search limit or
+    gains energy: one ``warning:`` line each)."""
     from ..fitting.compare import compare
     from ..jsonsafe import clean_json
     from ..output import ResultFolder
@@ -43,7 +44,8 @@ def run_compare(file: str, models: str | None, out: str | None, options: FitOpti
     names = [n for n in FILES if plots or not n.endswith(".png")]
     if out is not None:
         ResultFolder(out, overwrite=force).check(names)
-    res = compare(meas, models, cv=cv, options=options)
+    with energy_warnings():
+        res = compare(meas, models, cv=cv, options=options)
     typer.echo(res.table())
     if out is not None:
         files: dict[str, Any] = {
@@ -58,7 +60,10 @@ def run_compare(file: str, models: str | None, out: str | None, options: FitOpti
             for name, content in files.items():
                 folder.add(name, content, binary=callable(content))
         typer.echo("wrote " + ", ".join(str(folder.path / n) for n in files))
-    return 0 if all(c.result.success for c in res.candidates) else 1
+    # the best candidate's trust decides (the others' problems are in the table)
+    best = res.best.result
+    trusted = echo_untrusted(best)
+    return 0 if all(c.result.success for c in res.candidates) and trusted else 1
 
 
 #: the parameters of ``roughbrdf compare``, in the order of its help

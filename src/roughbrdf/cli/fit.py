@@ -27,14 +27,20 @@ A parameter whose unit is an angle (Oren-Nayar ``sigma``, also in ``coated(diffu
 oren-nayar)`` and in sums) is in degrees in ``-p`` and ``--bounds`` and in the report printed
 and written to ``report.txt``; ``fit.json`` holds radians, as the library does.
 
-Exit status 1 when the fit did not converge for some channel (the results are written).
+Exit status 1 when the fit did not converge for some channel, when a parameter ended on a
+search limit (a bound of the search that is no physical limit) or when a fitted model gains
+energy (albedo > 1 at some incidence; one ``warning:`` line each): the results are written, not
+to be trusted without a look.
 """
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import inspect
 import math
+import warnings
+from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -45,6 +51,7 @@ from .options import ModelInput, ReadInput, channel_labels, command, fit_options
 
 if TYPE_CHECKING:
     from ..fitting.options import FitOptions
+    from ..fitting.result import FitResult
     from ..measurement import Measurement
     from ..models import Model
 
@@ -226,7 +233,8 @@ def resolve_model(given: ModelInput, options: FitOptions) -> tuple[Model | str, 
 
 def run_fit(file: str, out: str, given: ModelInput, options: FitOptions, read: ReadInput, *,
             cv: bool, plots: bool, force: bool, quiet: bool) -> int:
-    """The work of ``roughbrdf fit``; returns the exit status (0, or 1 if not converged).
+    """The work of ``roughbrdf fit``; returns the exit status (0, or 1 if not converged, on a
+    search limit or gaining energy: :func:`echo_untrusted`).
 
     Everything that can be checked is checked before the fit: the options (``options`` were
     checked when made), the input file, and that ``out`` may receive the results
@@ -240,10 +248,11 @@ def run_fit(file: str, out: str, given: ModelInput, options: FitOptions, read: R
     meas = read_input(file, read.file_format, read.quantity, read.angles_in)
     chans = channel_labels(options)
     ResultFolder(out, overwrite=force).check(result_names(meas, chans, plots, given.auto))
-    if given.auto:
-        res = fit_auto(meas, given.models, cv=cv, options=options)
-    else:
-        res = fit(m, meas, options=options)
+    with energy_warnings():
+        if given.auto:
+            res = fit_auto(meas, given.models, cv=cv, options=options)
+        else:
+            res = fit(m, meas, options=options)
     # the report in degrees with the unit named, on the terminal and in report.txt (fit.json
     # keeps the library's radians)
     written = res.save(out, plots=plots, overwrite=force, report_angles="deg")
@@ -251,7 +260,36 @@ def run_fit(file: str, out: str, given: ModelInput, options: FitOptions, read: R
         typer.echo(res.report(angles="deg"))
         typer.echo("")
     typer.echo("wrote " + ", ".join(str(p) for p in written))
-    return 0 if res.success else 1
+    trusted = echo_untrusted(res)
+    return 0 if res.success and trusted else 1
+
+
+@contextlib.contextmanager
+def energy_warnings() -> Iterator[None]:
+    """Silence the :class:`~roughbrdf.fitting.plausibility.EnergyWarning` of a fit: the CLI
+    words them itself (:func:`echo_untrusted`), one ``warning:`` line each."""
+    from ..fitting.plausibility import EnergyWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", EnergyWarning)
+        yield
+
+
+def echo_untrusted(res: FitResult) -> bool:
+    """Print a ``warning:`` line (stderr) for each channel of ``res`` whose model gains energy
+    and each with a parameter on a search limit; whether there was none (a fit to trust)."""
+    for i, c in enumerate(res.channels):
+        p = res.plausibility(i)
+        if p.gains_energy:
+            typer.echo(f"warning: {res.model_name}, channel {c.channel}: the fitted model "
+                       f"reflects more than it receives (albedo {p.max_albedo:.4g} at "
+                       f"theta_i = {p.worst_incidence:g} deg): not physical", err=True)
+        names = [nm for nm, k in c.limits.items() if k.startswith("search")]
+        if names:
+            typer.echo(f"warning: {res.model_name}, channel {c.channel}: {', '.join(names)} "
+                       "ended on a search limit (a bound of the search, not a physical "
+                       "limit): not a result", err=True)
+    return not (res.at_search_limit or res.gains_energy)
 
 
 #: the parameters of ``roughbrdf fit``, in the order of its help

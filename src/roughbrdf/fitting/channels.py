@@ -19,6 +19,7 @@ from .data import ChannelData, prepare_channel
 from .joint import fit_joint
 from .objective import ObjectiveSpec
 from .plan import FitPlan, channel_indices, check_enough_data
+from .plausibility import warn_energy
 from .polarimetric import fit_mueller
 from .result import ChannelFit, FitResult
 from .search import MultiStart, SearchOptions, progress_bar
@@ -45,15 +46,22 @@ def refuse_polarimetric_weight(options: FitOptions) -> None:
                             value=options.polarimetric_weight)
 
 
-def fit_model(model: Model | str, measurement: Measurement, options: FitOptions
-              ) -> FitResult:
+def fit_model(model: Model | str, measurement: Measurement, options: FitOptions, *,
+              check_energy: bool = True) -> FitResult:
     """Fit one model (an instance, a name or a spec; not ``"auto"``) with ``options``:
     Mueller data with :func:`~roughbrdf.fitting.polarimetric.fit_mueller`, others with
-    :func:`fit_channels`."""
+    :func:`fit_channels`. With ``check_energy``, an
+    :class:`~roughbrdf.fitting.plausibility.EnergyWarning` for each channel whose fitted model
+    reflects more than it receives (the refits of a cross-validation skip the check)."""
+    res: FitResult
     if is_mueller(measurement):  # Mueller elements: all at once
-        return fit_mueller(model, measurement, options=options)
-    refuse_polarimetric_weight(options)
-    return fit_channels(as_model(model), measurement, options)
+        res = fit_mueller(model, measurement, options=options)
+    else:
+        refuse_polarimetric_weight(options)
+        res = fit_channels(as_model(model), measurement, options)
+    if check_energy:
+        warn_energy(res, stacklevel=4)
+    return res
 
 
 def fit_channels(model: Model, measurement: Measurement, options: FitOptions) -> FitResult:

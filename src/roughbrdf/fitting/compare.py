@@ -30,6 +30,7 @@ full fit used).
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -42,6 +43,7 @@ from ..models.factory import split_specs
 from ..quantity import Loss
 from .channels import fit_model
 from .options import FitOptions
+from .plausibility import ENERGY_TOLERANCE, EnergyWarning, warn_energy
 
 if TYPE_CHECKING:
     from ..measurement import Measurement
@@ -103,11 +105,34 @@ class Candidate:
 
     def row(self) -> dict[str, Any]:
         """The table row as plain values (``fit.json``)."""
-        params = {c.channel: dict(c.params) for c in self.result.channels}
+        res = self.result
+        params = {c.channel: dict(c.params) for c in res.channels}
+        plaus = {c.channel: res.plausibility(i).to_dict() for i, c in enumerate(res.channels)}
         return {"model": self.label, "k": self.k, "n_points": self.n_points, "aic": self.aic,
                 "bic": self.bic, "sigma": self.sigma, "rms_log": self.rms_log,
                 "rms_log_by_theta_r": self.bands, "cv": self.cv, "params": params,
-                "elapsed_s": self.elapsed}
+                "limits": {c.channel: c.limits for c in res.channels},
+                "plausibility": plaus, "elapsed_s": self.elapsed}
+
+    @property
+    def max_albedo(self) -> float:
+        """The largest albedo of the candidate's fitted models (all channels)."""
+        res = self.result
+        return max(res.plausibility(i).max_albedo for i in range(len(res.channels)))
+
+    @property
+    def worst_peak_ratio(self) -> float:
+        """The model/data peak ratio farthest from 1 (as a factor), all channels."""
+        res = self.result
+        ratios = [r for i in range(len(res.channels)) for r in res.plausibility(i).peak_ratio
+                  if math.isfinite(r) and r > 0]
+        return max(ratios, key=lambda r: abs(math.log(r))) if ratios else math.nan
+
+    @property
+    def search_limits(self) -> list[str]:
+        """The parameters (of any channel) that ended on a search limit."""
+        return sorted({nm for c in self.result.channels for nm, k in c.limits.items()
+                       if k.startswith("search")})
 
 
 @dataclass
@@ -133,14 +158,19 @@ class ModelComparison:
         """The comparison as a Markdown table, with the notes below it."""
         bands = list(self.best.bands)
         head = ["model", "k", "sigma", "rms-log", "dBIC", "dAIC", "CV",
-                *[f"rms-log {b}" for b in bands], "time (s)"]
+                *[f"rms-log {b}" for b in bands], "max albedo", "peak ratio", "search limit",
+                "time (s)"]
         lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
         b0, a0 = self.best.bic, min(c.aic for c in self.candidates)
         for c in self.candidates:
             cells = [c.label, str(c.k), f"{c.sigma:.3f}", f"{c.rms_log:.3f}",
                      f"{c.bic - b0:.0f}", f"{c.aic - a0:.0f}",
                      "-" if c.cv is None else f"{c.cv:.4f}",
-                     *[_num(c.bands[b]) for b in bands], f"{c.elapsed:.1f}"]
+                     *[_num(c.bands[b]) for b in bands],
+                     _num(c.max_albedo) + (" (gains energy)" if c.max_albedo > 1 + ENERGY_TOLERANCE
+                                           else ""),
+                     _num(c.worst_peak_ratio), ", ".join(c.search_limits) or "-",
+                     f"{c.elapsed:.1f}"]
             lines.append("| " + " | ".join(cells) + " |")
         return "\n".join(lines + [""] + [f"- {n}" for n in self.notes])
 
@@ -232,7 +262,7 @@ def cross_validate(result: FitResult, options: FitOptions | Mapping[str, Any]) -
                 channel=[c.channel for c in group], starts=1, progress=False, subsample=None,
                 joint=joint, shared=result.options["joint"]["shared"] if joint else None,
                 weights=weights)
-            fold = fit_model(group[0].model, train, fold_options)
+            fold = fit_model(group[0].model, train, fold_options, check_energy=False)
             for c, fc in zip(group, fold.channels, strict=True):
                 idx = c.index[out[c.index]]
                 if idx.size == 0:
@@ -342,6 +372,10 @@ def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | 
     best_cv = ModelComparison(rows, measurement).best_cv
     if best_cv is not None and best_cv is not rows[0]:
         notes.append(f"cross-validation prefers {best_cv.label} (BIC: {rows[0].label})")
+    notes.append("max albedo: the fitted model's largest directional-hemispherical reflectance "
+                 "(0-85 deg; > 1 gains energy); peak ratio: model/data maximum of the "
+                 "incidence where it is farthest from 1; search limit: parameters that ended "
+                 "on a search bound that is no physical limit (not a result)")
     return ModelComparison(rows, measurement, notes)
 
 
@@ -360,8 +394,11 @@ def fit_auto(measurement: Measurement, candidates: Sequence[Model | str] | str |
                                 "candidates have different parameters: choose the model, or "
                                 "compare candidates (rb.compare)", value=value)
     keywords = {k: v for k, v in keywords.items() if k not in ("fix", "bounds")}
-    choice = compare(measurement, candidates, cv=cv, options=options, **keywords)
+    with warnings.catch_warnings():  # the candidates not chosen do not matter: the best's below
+        warnings.simplefilter("ignore", EnergyWarning)
+        choice = compare(measurement, candidates, cv=cv, options=options, **keywords)
     best = choice.best.result
+    warn_energy(best, stacklevel=3)
     best.model_choice = choice
     best.model_name = choice.best.label
     best.elapsed = sum(c.result.elapsed for c in choice.candidates)

@@ -13,9 +13,13 @@ unit named, in radians (the library's unit, ``angles="rad"``, the default) or in
 always holds radians.
 
 Honest at bounds: a parameter at a bound (:func:`~roughbrdf.fitting.statistics.at_bound`) is
-printed ``(at the lower bound: no stderr)`` with a note why (the covariance is not meaningful
-at an active bound); a relative error is printed as a percentage only up to 1000 %
-(:func:`percent`); ``# starts`` is the number of local fits run, which is the number asked.
+printed ``(at the lower bound, a physical limit; no stderr)`` or ``(at the upper bound, a search
+limit: not a result; no stderr)`` (:func:`~roughbrdf.fitting.statistics.limit_kinds`) with a
+note why (the covariance is not meaningful at an active bound); the ``[[Plausibility]]`` block
+gives the albedo by incidence and the model/data peak ratios
+(:mod:`~roughbrdf.fitting.plausibility`); a relative error is printed as a percentage only up
+to 1000 % (:func:`percent`); ``# starts`` is the number of local fits run, which is the
+number asked.
 """
 
 from __future__ import annotations
@@ -58,8 +62,9 @@ def report(result: FitResult, *, min_correl: float = 0.1, angles: str = "rad") -
     if angles not in ANGLE_UNITS:  # a typo would silently print radians
         raise ArgumentError("angles", "must be 'rad' or 'deg'", value=angles)
     lines = _header(result)
-    for c in result.channels:
-        lines += ["", *_channel(c), *_variables(c, angles), *_correlations(c, min_correl)]
+    for i, c in enumerate(result.channels):
+        lines += ["", *_channel(c), *_variables(c, angles), *_correlations(c, min_correl),
+                  *result.plausibility(i).lines()]
         # a Mueller fit's channel adds its normalized elements (fitting.polarimetric)
         lines += getattr(c, "report_lines", list)()
     if result.model_choice is not None:
@@ -198,7 +203,9 @@ def _variable(c: ChannelFit, name: str, val: float | None, angle: str | None) ->
     tail = f"(init = {shown(c.init[name])}{unit}, bounds [{shown(lo)}, {shown(hi)}]{unit})"
     side = c.at_bound.get(name)
     if side is not None:
-        return f"{shown(val, 7)}{unit} (at the {side} bound: no stderr) {tail}"
+        kind = c.limits.get(name, "search").split("-")[0]
+        what = ("search limit: not a result" if kind == "search" else "physical limit")
+        return f"{shown(val, 7)}{unit} (at the {side} bound, a {what}; no stderr) {tail}"
     se = c.stderr.get(name)
     return f"{shown(val, 7)}{unit} +/- {shown(se, 4)}{unit}{percent(se, val)} {tail}"
 
@@ -214,6 +221,12 @@ def _variables(c: ChannelFit, angles: str = "rad") -> list[str]:
         lines += [f"    ({names} at a bound: no standard error, since the covariance is not "
                   f"meaningful",
                   f"     at an active bound; the others' are computed with {names} held there)"]
+        search = [nm for nm, k in c.limits.items() if k.startswith("search")]
+        if search:
+            lines += [f"    SEARCH LIMIT: {', '.join(search)} ended on a bound of the search that "
+                      f"is no physical limit:",
+                      "     the value is where the search stopped, not a result (widen the "
+                      "bounds or change the model)"]
     if c.free_scale:
         lines.append(f"    {'scale K':<{width}}: {fmt(c.scale, 7)} +/- "
                      f"{fmt(c.scale_stderr, 4)}{percent(c.scale_stderr, c.scale)} (closed form)")

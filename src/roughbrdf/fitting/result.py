@@ -25,7 +25,8 @@ from ..instrument import Aperture, aperture_average
 from ..jsonsafe import clean_json
 from ..quantity import Quantity
 from .data import input_source
-from .statistics import Covariance, GoodnessOfFit, at_bound
+from .plausibility import Plausibility, channel_plausibility
+from .statistics import Covariance, GoodnessOfFit, at_bound, limit_kinds
 
 if TYPE_CHECKING:
     from ..measurement import Measurement
@@ -59,12 +60,10 @@ class ChannelFit:
         ``name -> standard error`` (``None`` for fixed parameters, ``nan`` if not estimable or
         at a bound).
     at_bound : dict
-        ``name -> "lower" | "upper"`` for the free parameters at (or within a relative
-        :data:`~roughbrdf.fitting.statistics.AT_BOUND_RTOL` of the width of their bounds from)
-        a bound. They have no standard error and no correlations: the covariance is not
-        meaningful at an active bound (it assumes the optimum is an interior minimum of the
-        cost; there the bound, not the data, sets the value). The other parameters' covariance
-        is computed with them held at the bound.
+        ``name -> "lower" | "upper"`` for the free parameters at a bound
+        (:func:`~roughbrdf.fitting.statistics.at_bound`): no standard error nor correlations
+        (the covariance is not meaningful at an active bound); the others' covariance is
+        computed with them held there. :attr:`limits` tells a physical edge from a search limit.
     correl : dict
         ``name -> {other: correlation}`` among the free parameters (and ``"scale"``).
     covar : numpy.ndarray
@@ -136,6 +135,14 @@ class ChannelFit:
     fitted: np.ndarray = field(repr=False)
     residual: np.ndarray = field(repr=False)
     at_bound: dict[str, str] = field(default_factory=dict)
+    #: the :class:`~roughbrdf.fitting.plausibility.Plausibility` (:meth:`FitResult.plausibility`)
+    plausibility: Plausibility | None = field(default=None, repr=False)
+
+    @property
+    def limits(self) -> dict[str, str]:
+        """``{name: "physical-lower" | "search-upper" ...}`` of the parameters :attr:`at_bound`
+        (:func:`~roughbrdf.fitting.statistics.limit_kinds`)."""
+        return limit_kinds(self.at_bound, self.bounds, self.model.parameters)
 
     @property
     def metrics(self) -> dict[str, float | int]:
@@ -191,7 +198,7 @@ class ChannelFit:
     def to_dict(self) -> dict[str, Any]:
         """This channel's entry of ``fit.json`` (before NaN -> null)."""
         return {"channel": self.channel, "params": self.params, "stderr": self.stderr,
-                "at_bound": self.at_bound, "success": bool(self.success),
+                "at_bound": self.at_bound, "limits": self.limits, "success": bool(self.success),
                 "metrics": self.metrics,
                 "message": self.message, "free": self.free, "init": self.init,
                 "bounds": {k: list(v) for k, v in self.bounds.items()}, "scale": self.scale,
@@ -273,6 +280,24 @@ class FitResult:
         return all(c.success for c in self.channels)
 
     @property
+    def at_search_limit(self) -> bool:
+        """Whether a parameter of some channel ended on a search limit (not a result)."""
+        return any(k.startswith("search") for c in self.channels for k in c.limits.values())
+
+    @property
+    def gains_energy(self) -> bool:
+        """Whether some channel's model reflects more than it receives (albedo > 1)."""
+        return any(self.plausibility(i).gains_energy for i in range(len(self.channels)))
+
+    def plausibility(self, channel: int | str = 0) -> Plausibility:
+        """The albedo and peak ratios of a channel (:mod:`~roughbrdf.fitting.plausibility`),
+        computed once."""
+        c = self[channel]
+        if c.plausibility is None:
+            c.plausibility = channel_plausibility(c, self.measurement.theta_i[c.index])
+        return c.plausibility
+
+    @property
     def instrument(self) -> Aperture | None:
         """The fit's aperture as an :class:`~roughbrdf.instrument.Aperture` (None: none)."""
         return None if self.aperture is None else Aperture(self.aperture, self.aperture_points)
@@ -322,7 +347,9 @@ class FitResult:
             "quantity": self.measurement.quantity, "compared": self.compared,
             "relative_to": self.relative_to, "sample": meta.get("sample"),
             "options": self.options, "aperture": None if ap is None else ap.to_dict(),
-            "elapsed_s": self.elapsed, "channels": [c.to_dict() for c in self.channels],
+            "elapsed_s": self.elapsed,
+            "channels": [{**c.to_dict(), **self.plausibility(i).to_dict()}
+                         for i, c in enumerate(self.channels)],
             "model_choice": None if self.model_choice is None else self.model_choice.to_dict(),
         })
 
@@ -405,19 +432,10 @@ class FitResult:
         committed together at the end: an error or Ctrl-C leaves the folder as it was (the
         previous complete set), never a mix, never a 0-byte file.
 
-        Parameters
-        ----------
-        out_dir : str or path-like
-            The folder (created if needed).
-        plots : bool
-            Draw ``fit_<channel>.png`` (:meth:`plot`).
-        overwrite : bool
-            Replace the set of results in ``out_dir`` (stale files of the old set are removed).
-        dpi : int
-            Resolution of the PNGs.
-        report_angles : {"rad", "deg"}
-            Unit of the angle parameters in ``report.txt`` (``roughbrdf fit``: degrees);
-            ``fit.json`` holds radians.
+        ``out_dir``: the folder (created if needed); ``plots``: draw ``fit_<channel>.png``
+        (:meth:`plot`); ``overwrite``: replace the set of results in ``out_dir`` (stale files of
+        the old set are removed); ``dpi``: of the PNGs; ``report_angles`` (``"rad"``,
+        ``"deg"``): unit of the angle parameters in ``report.txt`` (fit.json holds radians).
 
         Returns
         -------

@@ -13,22 +13,27 @@ and statistics").
   bounds from) a bound. They get no standard error: the covariance describes the cost as a
   quadratic bowl around an interior optimum, which an active bound is not (the optimum there is
   set by the bound, not by the data, and the bowl may not even curve up along that
-  parameter). The covariance of the others is computed with them held at their bounds.
+  parameter). The covariance of the others is computed with them held at their bounds;
+* :func:`limit_kinds` -- whether each bound reached is a *physical* limit (an edge of the
+  parameter's domain, :attr:`Parameter.domain <roughbrdf.models.parameters.Parameter.domain>`:
+  ``k = 0``, a reflectance at 0 or 1) or only a *search* limit (a bound of the search that is no
+  domain edge, such as coated ``n = 2.5``): a value on a search limit is not a result.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 if TYPE_CHECKING:
     from .objective import Objective
 
-__all__ = ["AT_BOUND_RTOL", "Covariance", "GoodnessOfFit", "at_bound", "rms_log", "tr75_sigma"]
+__all__ = ["AT_BOUND_RTOL", "Covariance", "GoodnessOfFit", "at_bound", "limit_kinds", "rms_log",
+           "tr75_sigma"]
 
 #: a parameter within this fraction of the width of its bounds from a bound is "at the bound"
 AT_BOUND_RTOL = 1e-6
@@ -57,6 +62,36 @@ def at_bound(theta: np.ndarray, lower: np.ndarray, upper: np.ndarray, names: Seq
             if dist <= tol:
                 out[nm] = side
                 break
+    return out
+
+
+def limit_kinds(at: Mapping[str, str], bounds: Mapping[str, tuple[float, float]],
+                parameters: Sequence[Any]) -> dict[str, str]:
+    """``{name: "physical-lower" | "physical-upper" | "search-lower" | "search-upper"}`` for
+    the parameters ``at`` a bound (:func:`at_bound`).
+
+    ``bounds`` are the search bounds (``name -> (low, high)``), ``parameters`` the model's
+    :class:`~roughbrdf.models.parameters.Parameter` objects. A bound is physical when it is the
+    parameter's domain edge on that side (to 1e-9 relative), else a search limit. A name with
+    no parameter of that name (a joint fit's ``name[channel]``) is looked up by its stem.
+
+    Examples
+    --------
+    >>> from roughbrdf.models.parameters import nonnegative, positive
+    >>> ps = [nonnegative("k", 0.0, (0.0, 10.0), "1", ""), positive("n", 1.5, (0.2, 5.0), "1", "")]
+    >>> limit_kinds({"k": "lower", "n": "upper"}, {"k": (0.0, 10.0), "n": (0.2, 5.0)}, ps)
+    {'k': 'physical-lower', 'n': 'search-upper'}
+    """
+    by_name = {p.name: p for p in parameters}
+    out: dict[str, str] = {}
+    for nm, side in at.items():
+        par = by_name.get(nm, by_name.get(nm.split("[")[0]))
+        lo, hi = bounds.get(nm, (math.nan, math.nan))
+        b = lo if side == "lower" else hi
+        edge = math.nan if par is None else par.domain[0 if side == "lower" else 2]
+        # an infinite edge is never reached by a finite bound; NaN (unknown) is a search limit
+        physical = math.isfinite(edge) and abs(b - edge) <= 1e-9 * max(1.0, abs(edge))
+        out[nm] = f"{'physical' if physical else 'search'}-{side}"
     return out
 
 

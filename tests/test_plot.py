@@ -158,7 +158,8 @@ def test_comparison_parity_fallback_and_residual_map(tr):
     assert len(fig.axes) == 2 and "model" in fig.axes[1].get_ylabel()
     assert "r.m.s." in ax.get_title()
     offsets = ax.collections[0].get_offsets()
-    np.testing.assert_allclose(offsets[:, 0], np.sin(tr_) * np.cos(ph))
+    # the residual panels' axes are theta_r cos(phi), theta_r sin(phi) in degrees
+    np.testing.assert_allclose(offsets[:, 0], np.degrees(tr_) * np.cos(ph))
 
 
 def test_residual_map_on_noisy_data_and_channels(tr):

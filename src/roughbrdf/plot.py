@@ -25,7 +25,7 @@ function                   what it draws
 :func:`plot_polar`         TR75-style polar plot of the BRIDF against azimuth, ⊥ and ∥ (Fig. 6)
 :func:`plot_hemisphere`    heat map on the projected disk ``(sin θ cos φ, sin θ sin φ)``
 :func:`plot_comparison`    measurement vs model, in-plane slices, one colour per incidence
-:func:`plot_residual_map`  relative residual ``(data - model)/model`` on the projected disk
+:func:`plot_residual_map`  relative residual ``(data - model)/model``, one map per incidence
 =========================  ==================================================================
 """
 
@@ -405,14 +405,15 @@ def _comparison_title(model: Model, meas: Measurement, k: float,
 
 
 def _in_plane_slices(ax: Axes, model: Model, inplane: Measurement, k: float, curve_q: str,
-                     aperture: Aperture | float | None) -> np.ndarray:
-    """Data markers and model curves per incidence (and polarization); returns the data."""
+                     aperture: Aperture | float | None) -> tuple[np.ndarray, list[float]]:
+    """Data markers and model curves per incidence (and polarization); returns the data and,
+    per curve, the model's largest finite value over the signed angles the data span."""
     incs = inplane.incidences(4)
     ts_grid = _signed_grid(361, 89.5)
     tr_g, ph_g = geometry.from_signed_angle(ts_grid)
     groups = _pol_groups(inplane)
     markers = ["o", "s", "^", "D"]
-    all_vals = []
+    all_vals, peaks = [], []
     for t, col in zip(incs, incidence_colors(len(incs)), strict=True):
         sel = inplane.at_incidence(float(t), atol=1e-4)
         for gi, (pol, _mask, pname) in enumerate(groups):
@@ -427,7 +428,15 @@ def _in_plane_slices(ax: Axes, model: Model, inplane: Measurement, k: float, cur
             yc = compared_values(model, float(t), tr_g, ph_g, curve_q, pol, aperture) / k
             ax.plot(_deg(ts_grid), yc, color=col, lw=1.2, ls="-" if gi == 0 else "--",
                     label=rf"model $\theta_i$ = {math.degrees(t):.3g}°{pname}")
-    return np.concatenate(all_vals) if all_vals else np.array([])
+            # the peak within the data's span (a model may diverge toward grazing, where no
+            # sample says anything), plus the model at the samples (a peak between grid points)
+            span = (_deg(ts_grid) >= x.min()) & (_deg(ts_grid) <= x.max())
+            at = compared_values(model, sub.theta_i, sub.theta_r, sub.phi, curve_q, pol,
+                                 aperture) / k
+            both = np.concatenate([yc[span], np.atleast_1d(at)])
+            if np.isfinite(both).any():
+                peaks.append(float(np.nanmax(np.where(np.isfinite(both), both, np.nan))))
+    return (np.concatenate(all_vals) if all_vals else np.array([])), peaks
 
 
 def plot_comparison(model: Model, measurement: Measurement, *, channel: int | str = 0,
@@ -459,7 +468,7 @@ def plot_comparison(model: Model, measurement: Measurement, *, channel: int | st
     if inplane.n_samples == 0:
         _parity(ax, data, mod, ylabel, title)
         return fig, ax
-    _value_axis(ax, _in_plane_slices(ax, model, inplane, k, curve_q, aperture))
+    _value_axis(ax, *_in_plane_slices(ax, model, inplane, k, curve_q, aperture))
     ax.set_xlim(-90, 90)
     ax.set_xticks(np.arange(-90, 91, 30))
     ax.set_xlabel(SIGNED_LABEL)
@@ -471,18 +480,22 @@ def plot_comparison(model: Model, measurement: Measurement, *, channel: int | st
     return fig, ax
 
 
-def _value_axis(ax: Axes, vals: np.ndarray) -> None:
-    """The data set the value range (a model can diverge at grazing, e.g. unshadowed TR75);
-    logarithmic when they span more than a factor 30."""
+def _value_axis(ax: Axes, vals: np.ndarray, peaks: Sequence[float] = ()) -> None:
+    """The value range: the data and each model curve's peak (``peaks``, over the angles the
+    data span), padded by a factor 3 on log axes and 5 % on linear ones; logarithmic when the
+    data span more than a factor 30."""
+    top = np.concatenate([vals, np.asarray(peaks, dtype=float)])
     if _auto_log(vals):
         ax.set_yscale("log")
         pos = vals[np.isfinite(vals) & (vals > 0)]
+        hi = float(np.max(top[np.isfinite(top) & (top > 0)]))
         # the 0.5th percentile keeps a few noise values near zero from stretching the axis
-        ax.set_ylim(max(pos.min(), float(np.percentile(pos, 0.5))) / 3, pos.max() * 3)
+        ax.set_ylim(max(pos.min(), float(np.percentile(pos, 0.5))) / 3, hi * 3)
     elif np.isfinite(vals).any():
-        fin = vals[np.isfinite(vals)]
+        fin = top[np.isfinite(top)]
         lo, hi = min(0.0, float(fin.min())), float(fin.max())
-        ax.set_ylim(lo - 0.05 * (hi - lo), hi + 0.25 * (hi - lo) if hi > lo else hi + 1.0)
+        pad = 0.05 * (hi - lo) if hi > lo else 1.0  # all equal (e.g. zeros): a unit range
+        ax.set_ylim(lo - pad, hi + pad)
 
 
 def relative_residuals(model: Model, measurement: Measurement, *, channel: int | str = 0,
@@ -497,46 +510,91 @@ def relative_residuals(model: Model, measurement: Measurement, *, channel: int |
     return meas, res
 
 
+def _panel_grid(fig: Figure, ax: Axes, n: int) -> list[Axes]:
+    """``n`` panels in the place of ``ax`` in its figure (``ax`` the first), in the grid of
+    columns that gives the largest square panels."""
+    spec = ax.get_subplotspec()
+    if spec is None:  # an axes placed by hand (add_axes) has no grid cell to divide
+        raise ValueError("ax must be a subplot (fig.add_subplot) to hold the residual panels")
+    pos = ax.get_position()
+    w, h = pos.width * fig.get_figwidth(), pos.height * fig.get_figheight()
+    ncols = max(range(1, n + 1), key=lambda c: (min(w / c, h / math.ceil(n / c)), -c))
+    gs = spec.subgridspec(math.ceil(n / ncols), ncols)
+    ax.set_subplotspec(gs[0])
+    return [ax] + [fig.add_subplot(gs[j]) for j in range(1, n)]
+
+
+def _degree_disk(ax: Axes) -> None:
+    """Circles at theta_r = 30, 60, 90 deg and the plane of incidence of a residual panel,
+    whose axes are ``theta_r cos(phi)`` and ``theta_r sin(phi)`` in degrees."""
+    t = np.linspace(0, 2 * math.pi, 361)
+    for deg in (30, 60, 90):
+        ax.plot(deg * np.cos(t), deg * np.sin(t), color="0.6", lw=0.6 if deg < 90 else 1.0)
+    ax.axhline(0, color="0.6", lw=0.5)
+    ax.set_aspect("equal")
+    ax.set_xlim(-95, 95)
+    ax.set_ylim(-95, 95)
+    ax.set_xticks([-90, -60, -30, 0, 30, 60, 90])
+    ax.set_yticks([-90, -60, -30, 0, 30, 60, 90])
+    ax.tick_params(labelsize="x-small")
+
+
 def plot_residual_map(model: Model, measurement: Measurement, *, channel: int | str = 0,
                       ax: Axes | None = None, aperture: Aperture | float | None = None
                       ) -> tuple[Figure, Axes]:
-    """Relative residual ``(data - model)/model`` of every sample on the projected disk.
+    """Relative residual ``(data - model)/model`` of every sample, one panel per incidence.
 
-    Each sample sits at ``(sin θr cos φ, sin θr sin φ)`` (forward side to the right), coloured
-    by its residual on a diverging scale symmetric about 0 (clipped at the 98th percentile of
-    ``|residual|``, and at ±1 at most: a factor 2 off is saturated); each incidence has its own
-    marker. The r.m.s. relative residual (TR75's σ, Eq. 34) is in the title. ``aperture``: as
-    for :func:`plot_comparison`.
+    Each measured incidence has its own map of the reflection hemisphere: a sample sits at
+    ``(theta_r cos(phi), theta_r sin(phi))`` in degrees (forward side ``phi = 0`` to the right,
+    circles at ``theta_r`` = 30, 60, 90 deg, ``+`` the specular direction), coloured by its
+    residual on one diverging scale for all panels, symmetric about 0 (clipped at the 98th
+    percentile of ``|residual|``, and at ±1 at most: a factor 2 off is saturated), with one
+    colour bar. Each panel's title gives its incidence, the r.m.s. relative residual (TR75's
+    σ, Eq. 34) of its samples and their number; a new figure's title the r.m.s. of all.
+    ``aperture``: as for :func:`plot_comparison`. With ``ax`` (a subplot), its place in the
+    figure is divided into the panels, ``ax`` the first.
+
+    Returns
+    -------
+    (fig, ax)
+        ``ax`` is the first panel; every panel holds one scatter collection of its samples.
     """
     from matplotlib import colors as mcolors
 
-    fig, ax = new_axes(ax, figsize=(6.0, 4.8))
     meas, res = relative_residuals(model, measurement, channel=channel, aperture=aperture)
-    x = np.sin(meas.theta_r) * np.cos(meas.phi)
-    y = np.sin(meas.theta_r) * np.sin(meas.phi)
     ok = np.isfinite(res)
+    incs = [t for t in meas.incidences(4) if (ok & (np.abs(meas.theta_i - t) <= 1e-4)).any()]
+    n, own = max(len(incs), 1), ax is None
+    fig, ax = new_axes(ax, figsize=(min(n, 4) * 2.9 + 1.3, 3.3 * math.ceil(n / 4) + 0.4))
+    panels = _panel_grid(fig, ax, n)
+    x, y = _deg(meas.theta_r) * np.cos(meas.phi), _deg(meas.theta_r) * np.sin(meas.phi)
     p98 = float(np.percentile(np.abs(res[ok]), 98)) if ok.any() else 1.0
     lim = min(p98, 1.0) if p98 > 0 else 1.0
-    clipped = bool(ok.any() and np.abs(res[ok]).max() > lim)
     norm = mcolors.TwoSlopeNorm(vcenter=0.0, vmin=-lim, vmax=lim)
-    markers = ["o", "s", "^", "D", "v", "P", "X", "*", "<", ">"]
-    incs = meas.incidences(4)
+    ch = meas.channels[0]
     sc = None
-    for j, t in enumerate(incs):
+    for pax, t in zip(panels, incs, strict=False):
         m = (np.abs(meas.theta_i - t) <= 1e-4) & ok
-        if not m.any():
-            continue
-        sc = ax.scatter(x[m], y[m], c=np.clip(res[m], -lim, lim), cmap="RdBu_r", norm=norm,
-                        marker=markers[j % len(markers)], s=14, edgecolors="0.3",
-                        linewidths=0.2, label=rf"$\theta_i$ = {math.degrees(t):.3g}°")
-        ax.plot([math.sin(t)], [0.0], marker="+", color="k", ms=6, ls="none")
+        sc = pax.scatter(x[m], y[m], c=np.clip(res[m], -lim, lim), cmap="RdBu_r", norm=norm,
+                         s=9, edgecolors="0.3", linewidths=0.15, rasterized=True)
+        pax.plot([math.degrees(t)], [0.0], marker="+", color="k", ms=8, ls="none",
+                 label="specular")
+        rms_t = float(np.sqrt(np.mean(res[m] ** 2)))
+        pax.set_title(rf"$\theta_i$ = {math.degrees(t):.3g}° [{ch}]" + "\n"
+                      + f"r.m.s. {rms_t:.3g} ({int(m.sum())} samples)", fontsize="small")
+    for pax in panels:
+        _degree_disk(pax)
+    panels[0].set_xlabel(r"$\theta_r\cos\phi$ [deg] (forward $\rightarrow$)", fontsize="small")
+    panels[0].set_ylabel(r"$\theta_r\sin\phi$ [deg]", fontsize="small")
+    panels[0].legend(fontsize="x-small", loc="upper left", framealpha=0.6)
     if sc is not None:
-        fig.colorbar(sc, ax=ax, label="(data − model) / model", shrink=0.9,
+        clipped = bool(np.abs(res[ok]).max() > lim)
+        fig.colorbar(sc, ax=panels, label="(data − model) / model", shrink=0.9,
                      extend="both" if clipped else "neither")
-    disk_decorations(ax)
     rms = float(np.sqrt(np.mean(res[ok] ** 2))) if ok.any() else float("nan")
-    ax.set_title(f"{model.name}: relative residual [{meas.channels[0]}], r.m.s. {rms:.3g}",
-                 fontsize="medium")
-    if len(incs) <= 12:
-        ax.legend(fontsize="x-small", loc="upper left", framealpha=0.6)
-    return fig, ax
+    if not incs:  # nothing finite to draw: say so where the samples would be
+        panels[0].set_title(f"[{ch}] no finite residual", fontsize="small")
+    if own:  # a figure of the caller's keeps the caller's title
+        fig.suptitle(f"{model.name}: relative residual [{ch}], r.m.s. {rms:.3g} over "
+                     f"{int(ok.sum())} samples", fontsize="medium")
+    return fig, panels[0]

@@ -174,24 +174,55 @@ def _fit_channels(fit: dict[str, Any], channel: str | None, out: Path | None
     return chans
 
 
+def _fit_samples(fit: dict[str, Any], chan: dict[str, Any], meas: Any, ch: int, model: Any,
+                 aperture: Any) -> tuple[Any, str]:
+    """The samples of channel ``ch`` the fit used, as it compared them, and a note of those left
+    out and why.
+
+    The selection is the fit's own (:func:`roughbrdf.fitting.data.prepare_channel` with the
+    options of ``fit.json``); the values are multiplied by the fitted scale ``K`` and labelled
+    with the compared quantity, as :meth:`FitResult.plot_data
+    <roughbrdf.fitting.FitResult.plot_data>` does.
+    """
+    from dataclasses import replace
+
+    from ..fitting.data import Comparison, DataOptions, excluded_text, prepare_channel
+    from ..quantity import Quantity
+
+    o = fit.get("options") or {}
+    weights = o.get("weights")
+    opts = DataOptions(Comparison.of(meas, fit.get("relative_to")), fit.get("loss") or "relative",
+                       "uncertainty" if weights == "uncertainty" else None,
+                       o.get("nonfinite") or "raise", o.get("negative") or "keep", aperture,
+                       o.get("theta_r_max"), o.get("source_exclusion"),
+                       o.get("extrapolated") or "drop")
+    data = prepare_channel(model, meas, ch, opts)
+    sub = meas.subset(data.index).select_channel(ch)
+    scale = float(chan.get("scale") or 1.0)
+    sub = replace(sub, values=(scale * data.values)[:, None], uncertainty=None,
+                  quantity=Quantity.parse(fit.get("compared") or "brdf").compared_with(),
+                  meta=dict(sub.meta))
+    note = (f"{data.n} of {meas.n_samples} samples drawn: those the fit used; left out: "
+            f"{excluded_text(data.excluded)}")
+    if weights == "array":  # fit.json does not record a weights array: its zeros are unknown
+        note += " (the fit's weights are not recorded: samples of weight 0 are drawn too)"
+    return sub, note
+
+
 def _fit_figure(fit: dict[str, Any], fit_dir: Path, meas: Any, chan: dict[str, Any],
                 aperture: Any) -> Any:
-    """Data vs model and the residual map of one channel of the fit."""
-    from matplotlib.figure import Figure
-
-    from .. import plot as rbplot
+    """Data vs model and the residual maps of one channel of the fit, on the fit's samples."""
+    from .. import plot_fit
     from ..fitting.result import channel_model
 
     model = channel_model(fit, chan)
     label = chan.get("channel")
     ch = meas.channel_index(label) if str(label) in meas.channels else 0
-    fig = Figure(figsize=(13, 5.2), layout="constrained")
-    ax1 = fig.add_subplot(1, 2, 1)
-    ax2 = fig.add_subplot(1, 2, 2)
-    rbplot.plot_comparison(model, meas, channel=ch, ax=ax1, aperture=aperture)
-    rbplot.plot_residual_map(model, meas, channel=ch, ax=ax2, aperture=aperture)
-    fig.suptitle(f"fit {fit_dir}: {fit['model']} to {Path(str(fit['file'])).name} "
-                 f"[{label}], loss {fit.get('loss', '?')}", fontsize="medium")
+    sub, note = _fit_samples(fit, chan, meas, ch, model, aperture)
+    fig, _axes = plot_fit.plot_fit(
+        model, sub, aperture=aperture, note=note,
+        title=f"fit {fit_dir}: {fit['model']} to {Path(str(fit['file'])).name} [{label}], "
+              f"loss {fit.get('loss', '?')}")
     return fig
 
 

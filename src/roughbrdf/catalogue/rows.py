@@ -8,7 +8,10 @@ other tools rely on these keys):
 ``channel``       channel label (str), or None when the file failed before its channels were
                   known
 ``model``         the fitted model's label (str)
-``status``        ``"ok"`` | ``"not converged"`` | ``"failed"`` | ``"skipped (resume)"``
+``status``        ``"ok"`` | ``"not converged"`` | ``"at-search-limit"`` (a parameter ended on
+                  a bound of the search that is no physical limit: not a result) |
+                  ``"gains-energy"`` (the fitted model's albedo exceeds 1 at some incidence)
+                  | ``"failed"`` | ``"skipped (resume)"`` (first that applies, in this order)
 ``error``         the error message (str) for ``"failed"``, else None
 ``params``        ``{name: value}`` of every parameter (empty when failed)
 ``stderr``        ``{name: standard error or None}``
@@ -21,6 +24,15 @@ other tools rely on these keys):
 ``sha256``        SHA-256 of the input file's bytes (None when it could not be read)
 ``fit_dir``       the file's fit folder, relative to the catalogue folder (str or None)
 ``figure``        the channel's ``fit_<channel>.png`` relative to the catalogue folder, or None
+``limits``        ``{name: "physical-lower" | "search-upper" ...}`` of the parameters at a bound
+                  (``catalogue.csv``: ``name=kind`` separated by ``;``)
+``search_limits`` the parameters on a search limit, ``", "``-separated (str or None)
+``max_albedo``    the largest albedo of the fitted model at 0, 10, ... 80, 85 deg (float or None)
+``gains_energy``  whether ``max_albedo`` exceeds ``1 + 1e-3`` (bool or None)
+``peak_ratio``    model/data peak ratio farthest from 1 over the measured incidences (float
+                  or None)
+``albedo``        ``{theta_i_deg: albedo}`` (``catalogue.csv``: ``albedo_<deg>`` columns)
+``peak_ratios``   ``{theta_i_deg: ratio}`` per measured incidence (``peak_ratio_<deg>``)
 ================  ============================================================================
 
 A ``"skipped (resume)"`` row carries the values of the earlier run it kept.
@@ -42,26 +54,58 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from ..fitting.result import FitResult
 
-__all__ = ["COLUMNS", "STATUSES", "failed_row", "fit_rows", "csv_text", "json_text"]
+__all__ = ["BY_INCIDENCE", "COLUMNS", "STATUSES", "failed_row", "fit_rows", "csv_text",
+           "json_text", "status_of"]
 
 #: the statuses a row can have
-STATUSES = ("ok", "not converged", "failed", "skipped (resume)")
+STATUSES = ("ok", "not converged", "at-search-limit", "gains-energy", "failed",
+            "skipped (resume)")
 
-#: the scalar columns, in the order of ``catalogue.csv`` (``param_*``/``stderr_*`` follow)
+#: the scalar columns, in the order of ``catalogue.csv`` (``param_*``/``stderr_*``, then
+#: ``albedo_*``/``peak_ratio_*`` follow)
 COLUMNS = ("file", "channel", "model", "status", "error", "sigma", "rms_log", "aic", "bic",
-           "n_points", "n_excluded", "elapsed_s", "sha256", "fit_dir", "figure")
+           "n_points", "n_excluded", "elapsed_s", "sha256", "fit_dir", "figure", "limits",
+           "search_limits", "max_albedo", "gains_energy", "peak_ratio")
+#: the per-incidence columns of ``catalogue.csv``: row key -> column prefix
+BY_INCIDENCE = {"albedo": "albedo_", "peak_ratios": "peak_ratio_"}
 
 
 def _empty(file: str, model: str, sha256: str | None) -> dict[str, Any]:
     row: dict[str, Any] = dict.fromkeys(COLUMNS)
-    row.update(file=file, model=model, sha256=sha256, params={}, stderr={})
+    row.update(file=file, model=model, sha256=sha256, params={}, stderr={}, limits={},
+               albedo={}, peak_ratios={})
     return row
+
+
+def status_of(res: FitResult, i: int) -> str:
+    """The status of channel ``i`` of ``res``: ``"not converged"``, ``"at-search-limit"``,
+    ``"gains-energy"`` or ``"ok"``, the first that applies."""
+    c = res.channels[i]
+    if not c.success:
+        return "not converged"
+    if any(k.startswith("search") for k in c.limits.values()):
+        return "at-search-limit"
+    return "gains-energy" if res.plausibility(i).gains_energy else "ok"
+
+
+def _plausibility_fields(res: FitResult, i: int) -> dict[str, Any]:
+    """The row's limits and plausibility keys for channel ``i`` of ``res``."""
+    c, p = res.channels[i], res.plausibility(i)
+    search = [nm for nm, k in c.limits.items() if k.startswith("search")]
+    finite = [r for r in p.peak_ratio if math.isfinite(r) and r > 0]
+    return dict(limits=dict(c.limits), search_limits=", ".join(search) or None,
+                max_albedo=p.max_albedo, gains_energy=p.gains_energy,
+                peak_ratio=max(finite, key=lambda r: abs(math.log(r))) if finite else None,
+                albedo={f"{t:g}": a for t, a in zip(p.albedo_theta_deg, p.albedo, strict=True)},
+                peak_ratios={f"{t:g}": r for t, r in zip(p.peak_theta_deg, p.peak_ratio,
+                                                         strict=True)})
 
 
 def failed_row(file: str, model: str, error: str, *, sha256: str | None,
@@ -79,10 +123,11 @@ def fit_rows(res: FitResult, file: str, *, fit_dir: str, figures: Sequence[str |
 
     src = res.source or {}
     rows = []
-    for c, fig in zip(res.channels, figures, strict=True):
+    for i, (c, fig) in enumerate(zip(res.channels, figures, strict=True)):
         row = _empty(file, res.model_name, src.get("file_sha256"))
+        row.update(_plausibility_fields(res, i))
         row.update(
-            channel=c.channel, status="ok" if c.success else "not converged",
+            channel=c.channel, status=status_of(res, i),
             params=dict(c.params), stderr=dict(c.stderr), sigma=c.sigma, rms_log=c.rms_log,
             aic=c.aic, bic=c.bic, n_points=c.n_points,
             n_excluded=int(sum(c.excluded.values())), elapsed_s=elapsed_s, fit_dir=fit_dir,
@@ -96,7 +141,12 @@ def _columns(rows: Sequence[dict[str, Any]]) -> list[str]:
     for r in rows:
         params.update(dict.fromkeys(r.get("params") or {}))
     names = list(params)
-    return [*COLUMNS, *(f"param_{n}" for n in names), *(f"stderr_{n}" for n in names)]
+    per: dict[str, dict[str, None]] = {key: {} for key in BY_INCIDENCE}
+    for r in rows:
+        for key in BY_INCIDENCE:
+            per[key].update(dict.fromkeys(r.get(key) or {}))
+    return [*COLUMNS, *(f"param_{n}" for n in names), *(f"stderr_{n}" for n in names),
+            *(f"{pre}{t}" for key, pre in BY_INCIDENCE.items() for t in per[key])]
 
 
 def csv_text(rows: Sequence[dict[str, Any]]) -> str:
@@ -109,6 +159,10 @@ def csv_text(rows: Sequence[dict[str, Any]]) -> str:
         flat = {k: r.get(k) for k in COLUMNS}
         flat.update({f"param_{k}": v for k, v in (r.get("params") or {}).items()})
         flat.update({f"stderr_{k}": v for k, v in (r.get("stderr") or {}).items()})
+        # a row of an older catalogue (resume) may lack these: empty cells
+        flat["limits"] = ";".join(f"{k}={v}" for k, v in (r.get("limits") or {}).items())
+        for key, pre in BY_INCIDENCE.items():
+            flat.update({f"{pre}{t}": v for t, v in (r.get(key) or {}).items()})
         w.writerow({k: ("" if v is None else v) for k, v in flat.items()})
     return buf.getvalue()
 

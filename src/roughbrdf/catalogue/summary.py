@@ -24,10 +24,11 @@ in the catalogue folder beside them, and embedding 60 figures as data URIs would
 megabytes to a page that must stay small at 100,000 rows. The page fetches nothing else.
 
 Row schema: ``file``, ``channel``, ``model``, ``status`` (``"ok"``, ``"not converged"``,
-``"failed"``, ``"skipped (resume)"``), ``error`` (str or None), ``params`` and ``stderr``
-({name: value}), ``sigma``, ``rms_log``, ``aic``, ``bic``, ``n_points``, ``n_excluded``,
-``elapsed_s``, ``sha256``, ``fit_dir`` (relative to the catalogue folder) and ``figure``
-(relative path of the fit's PNG, or None). Missing keys count as None.
+``"at-search-limit"``, ``"gains-energy"``, ``"failed"``, ``"skipped (resume)"``), ``error`` (str
+or None), ``params`` and ``stderr`` ({name: value}), ``search_limits`` (str or None),
+``max_albedo``, ``peak_ratio``, ``sigma``, ``rms_log``, ``aic``, ``bic``, ``n_points``,
+``n_excluded``, ``elapsed_s``, ``sha256``, ``fit_dir`` (relative to the catalogue folder) and
+``figure`` (relative path of the fit's PNG, or None). Missing keys count as None.
 
 Examples
 --------
@@ -63,14 +64,18 @@ __all__ = ["write_summary", "STATUSES", "SUMMARY_FILES"]
 SUMMARY_FILES = ("summary.md", "summary.html")
 
 #: the statuses of a row, in the order the counts list them
-STATUSES = ("ok", "not converged", "failed", "skipped (resume)")
+STATUSES = ("ok", "not converged", "at-search-limit", "gains-energy", "failed",
+            "skipped (resume)")
+#: the statuses of rows with a fit (their parameters are plotted)
+_FITTED = ("ok", "not converged", "at-search-limit", "gains-energy")
 
 #: table columns before the parameters: (key, label, type)
 _FIXED = (("file", "file", "text"), ("channel", "channel", "text"), ("model", "model", "text"),
           ("status", "status", "text"), ("n_points", "points", "num"),
           ("n_excluded", "excluded", "num"), ("sigma", "sigma", "num"),
           ("rms_log", "rms log", "num"), ("aic", "AIC", "num"), ("bic", "BIC", "num"),
-          ("elapsed_s", "time s", "num"))
+          ("search_limits", "search limit", "text"), ("max_albedo", "max albedo", "num"),
+          ("peak_ratio", "peak ratio", "num"), ("elapsed_s", "time s", "num"))
 #: failures listed by name (the rest are counted; the HTML table's filter finds them)
 _MAX_FAILURES = 100
 #: columns stored once per distinct value (index into a list) in the page's JSON
@@ -211,7 +216,7 @@ def _histogram_svg(name: str, values: np.ndarray, bins: int = 30) -> str:
 
 def _plots_html(rows: Sequence[Mapping[str, Any]], params: list[str]) -> str:
     """Histograms of every parameter and of ``rms_log`` over the fitted (ok) rows."""
-    fitted = [r for r in rows if r.get("status") in ("ok", "not converged")]
+    fitted = [r for r in rows if r.get("status") in _FITTED]
     series: list[tuple[str, list[Any]]] = [
         (p, [(r.get("params") or {}).get(p) for r in fitted]) for p in params]
     series.append(("rms_log", [r.get("rms_log") for r in fitted]))
@@ -324,14 +329,15 @@ def _markdown(rows: Sequence[Mapping[str, Any]], title: str, page_size: int) -> 
         lines.append(f"- … and {len(fails) - _MAX_FAILURES} more (filter the HTML table)")
     shown = rows[:max(1, int(page_size))]
     lines += ["", f"## Fits (first {len(shown)} of {len(rows)})", ""]
-    head = ["file", "channel", "model", "status", "rms log", "BIC", *params]
+    head = ["file", "channel", "model", "status", "rms log", "BIC", "max albedo", *params]
     lines += ["| " + " | ".join(_md_cell(h) for h in head) + " |",
               "|" + "---|" * 4 + "---:|" * (len(head) - 4)]
     for r in shown:
         name, link = _md_cell(r.get("file")), _href(r.get("fit_dir"))
         cells = [f"[{name}]({link})" if link else name, _md_cell(r.get("channel")),
                  _md_cell(r.get("model")), _md_cell(r.get("status")), _fmt(r.get("rms_log")),
-                 _fmt(r.get("bic")), *(_fmt((r.get("params") or {}).get(p)) for p in params)]
+                 _fmt(r.get("bic")), _fmt(r.get("max_albedo")),
+                 *(_fmt((r.get("params") or {}).get(p)) for p in params)]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 

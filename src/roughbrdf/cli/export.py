@@ -6,7 +6,9 @@ Writes a model, or the fitted models of a saved fit (``fit.json``), for another 
 ``--radial``, ``--azimuth`` in degrees, ``--symmetry``), a Mitsuba 3 scene-description dict as
 JSON, or a Mitsuba 3 XML ``<bsdf>``. What does not map onto Mitsuba is refused with the reason,
 or with ``--fit-closest`` exported as the closest Mitsuba model fitted to it, with the deviation
-printed. Nothing is replaced without ``--force``; every file is written atomically.
+printed. A model that reflects more than it receives (albedo above 1 + 1e-3 at an incidence of
+0, 5, ... 85, 89 deg) is refused unless ``--allow-energy-gain``, which the file records.
+Nothing is replaced without ``--force``; every file is written atomically.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ import typer
 from .common import EXPORT_OPTIONS, cli_model, degree_range, handled, parse_params
 
 #: the library's argument names -> this verb's options (errors name the options)
-OPTIONS = EXPORT_OPTIONS
+OPTIONS = {**EXPORT_OPTIONS, "allow_energy_gain": "--allow-energy-gain"}
 
 
 def _source(model: str | None, param: list[str] | None, fit_dir: str | None) -> Any:
@@ -50,7 +52,8 @@ def _zemax_options(incidences: str | None, radial: str | None, azimuth: str | No
 
 def run_export(model: str | None, param: list[str] | None, fit_dir: str | None, to: str,
                out: str, *, channel: str | None, force: bool, grid: dict[str, Any],
-               rgb: bool | None, fit_closest: bool, theta_max: float | None) -> None:
+               rgb: bool | None, fit_closest: bool, theta_max: float | None,
+               allow_energy_gain: bool = False) -> None:
     """The work of ``roughbrdf export``: checked, written, reported."""
     from ..export import export, target_name
 
@@ -76,7 +79,8 @@ def run_export(model: str | None, param: list[str] | None, fit_dir: str | None, 
     if channel is not None and channel.lstrip("-").isdigit() and isinstance(source, dict) \
             and channel not in source:
         chan = int(channel)
-    res = export(source, Path(out), to=target, overwrite=force, channel=chan, **options)
+    res = export(source, Path(out), to=target, overwrite=force, channel=chan,
+                 allow_energy_gain=allow_energy_gain, **options)
     typer.echo(res.report)
     typer.echo("wrote " + ", ".join(str(p) for p in res.paths))
 
@@ -117,9 +121,14 @@ def register(app: typer.Typer) -> None:
                                         help="Mitsuba: largest angle of the deviation grid "
                                              "(default 80)"),
         force: bool = typer.Option(False, "--force", help="replace existing files"),
+        allow_energy_gain: bool = typer.Option(
+            False, "--allow-energy-gain",
+            help="export a model that reflects more than it receives (albedo > 1 at some "
+                 "incidence; refused by default), recorded in the file"),
     ) -> None:
         """Export a model or a fit to Zemax OpticStudio (.bsdf) or Mitsuba 3 (dict, XML)."""
         with handled(OPTIONS):
             run_export(model, param, fit_dir, to, out, channel=channel, force=force,
                        grid=_zemax_options(incidences, radial, azimuth, symmetry), rgb=rgb,
-                       fit_closest=fit_closest, theta_max=theta_max)
+                       fit_closest=fit_closest, theta_max=theta_max,
+                       allow_energy_gain=allow_energy_gain)

@@ -29,8 +29,8 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time the two load on fir
     from .mitsuba import export_mitsuba
     from .zemax import to_zemax as export_zemax
 
-__all__ = ["TARGETS", "ExportResult", "export", "export_mitsuba", "export_to", "export_zemax",
-           "target_name"]
+__all__ = ["ENERGY_NOTE_KEY", "TARGETS", "ExportResult", "export", "export_mitsuba", "export_to",
+           "export_zemax", "target_name"]
 
 #: ``to=`` -> what is written
 TARGETS = {
@@ -97,7 +97,11 @@ def export(source: Any, out: str | os.PathLike, *, to: str, overwrite: bool = Fa
     **options
         The target's own: Zemax ``angles_of_incidence``, ``radial``, ``azimuth`` (radians),
         ``symmetry``, ``polarization`` (:func:`~roughbrdf.export.zemax.to_zemax`); Mitsuba
-        ``rgb``, ``fit``, ``theta_max`` (:func:`~roughbrdf.export.mitsuba.export_mitsuba`).
+        ``rgb``, ``fit``, ``theta_max`` (:func:`~roughbrdf.export.mitsuba.export_mitsuba`);
+        both ``allow_energy_gain``: a model whose albedo exceeds ``1 + 1e-3`` at an incidence
+        of 0, 5, ... 85, 89 deg is refused (an :class:`~roughbrdf.errors.ArgumentError`
+        naming the albedo and the incidence) unless it is True, which the file records (a
+        Zemax header comment, an XML comment, the JSON key :data:`ENERGY_NOTE_KEY`).
 
     Returns
     -------
@@ -130,30 +134,42 @@ def export(source: Any, out: str | os.PathLike, *, to: str, overwrite: bool = Fa
     suffix = ".json" if target == "mitsuba" else ".xml"
     base = Path(out) if Path(out).suffix else Path(out).with_suffix(suffix)
     if done.rule == "per-channel":  # one BSDF per channel: one file each, each loadable
-        files = {base.with_name(f"{base.stem}_{_safe(label)}{base.suffix}"): bsdf
-                 for label, bsdf in done.bsdf.items()}
+        files = {base.with_name(f"{base.stem}_{_safe(label)}{base.suffix}"):
+                 (bsdf, done.note_lines(label)) for label, bsdf in done.bsdf.items()}
     else:
-        files = {base: done.bsdf}
-    return ExportResult(target, _write_mitsuba(files, target, overwrite), done.summary(), done)
+        files = {base: (done.bsdf, done.note_lines())}
+    text = "\n".join([done.summary(), *done.note_lines()])
+    return ExportResult(target, _write_mitsuba(files, target, overwrite), text, done)
 
 
 def _safe(label: str) -> str:
     return re.sub(r"[^A-Za-z0-9.+-]+", "_", str(label)).strip("._") or "channel"
 
 
-def _write_mitsuba(files: dict[Path, dict[str, Any]], target: str, overwrite: bool
-                   ) -> list[Path]:
+#: the key of a Mitsuba JSON export recording ``allow_energy_gain=True`` (remove it before
+#: ``mitsuba.load_dict``: Mitsuba refuses a property no plugin reads)
+ENERGY_NOTE_KEY = "roughbrdf_allow_energy_gain"
+
+
+def _write_mitsuba(files: dict[Path, tuple[dict[str, Any], list[str]]], target: str,
+                   overwrite: bool) -> list[Path]:
     """Each BSDF as a Mitsuba document: the dict as JSON (``mitsuba.load_dict(json.load(f))``)
     or an XML ``<bsdf version="3.0.0">`` (``mitsuba.load_file``/``load_string``); every file
-    checked before the first is written, each written atomically."""
+    checked before the first is written, each written atomically. The notes (the record of
+    ``allow_energy_gain=True``) go in XML comments before the element, or in the JSON key
+    :data:`ENERGY_NOTE_KEY`."""
     from ..output import atomic_write, refuse_existing
-    from .mitsuba import xml_text
+    from .mitsuba.exporting import xml_comments
+    from .mitsuba.xml_writer import xml_text
 
     for path in files:
         refuse_existing(path, overwrite)
-    for path, bsdf in files.items():
-        text = (json.dumps(bsdf, indent=2, allow_nan=False) if target == "mitsuba"
-                else xml_text(bsdf, version="3.0.0"))
+    for path, (bsdf, notes) in files.items():
+        if target == "mitsuba":
+            text = json.dumps({**bsdf, ENERGY_NOTE_KEY: notes} if notes else bsdf, indent=2,
+                              allow_nan=False)
+        else:
+            text = xml_comments(notes) + xml_text(bsdf, version="3.0.0")
         atomic_write(path, text + "\n", overwrite=overwrite)
     return list(files)
 

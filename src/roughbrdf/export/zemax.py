@@ -308,8 +308,8 @@ def _check_targets(paths: list[Path], overwrite: bool) -> None:
 
 def to_zemax(model_or_fit: Any, out: str | os.PathLike, *, angles_of_incidence: Any = None,
              radial: Any = None, azimuth: Any = None, symmetry: str = "PlaneSymmetrical",
-             channel: Any = None, polarization: Any = None, overwrite: bool = False
-             ) -> ZemaxExport:
+             channel: Any = None, polarization: Any = None, overwrite: bool = False,
+             allow_energy_gain: bool = False) -> ZemaxExport:
     """Write a model, or each channel of a fit, as a Zemax tabular BSDF.
 
     Parameters
@@ -329,6 +329,11 @@ def to_zemax(model_or_fit: Any, out: str | os.PathLike, *, angles_of_incidence: 
         Incident polarization (:meth:`Model.brdf`); default unpolarized.
     overwrite : bool
         Replace existing files (default: refuse, before writing any).
+    allow_energy_gain : bool
+        Write a model that reflects more than it receives (albedo above ``1 + 1e-3`` at an
+        incidence of 0, 5, ... 85, 89 deg), recorded in a header comment; by default refused
+        with an :class:`~roughbrdf.errors.ArgumentError` naming the albedo and the incidence
+        (:func:`~roughbrdf.fitting.plausibility.refuse_energy_gain`).
 
     Returns
     -------
@@ -348,20 +353,24 @@ def to_zemax(model_or_fit: Any, out: str | os.PathLike, *, angles_of_incidence: 
     >>> bool(abs(m.values[:, 0] - 0.5 / 3.141592653589793).max() < 1e-12)
     True
     """
+    from ..fitting.plausibility import refuse_energy_gain
+
     pairs = _models(model_or_fit, channel)
     targets = _targets(out, [c for c, _ in pairs], single=len(pairs) == 1 and (
         isinstance(model_or_fit, Model) or channel is not None))
     _check_targets(targets, overwrite)
+    notes = [refuse_energy_gain({label: mdl}, allow_energy_gain) for label, mdl in pairs]
     grids = [_grid(mdl, angles_of_incidence, radial, azimuth, symmetry, polarization)
              for _, mdl in pairs]
     if len(targets) == 1:  # one file: written atomically on its own
         return ZemaxExport([_write_one(pairs[0][1], pairs[0][0], grids[0], targets[0],
-                                       polarization, overwrite)])
-    return ZemaxExport(_write_set(pairs, grids, targets, polarization, overwrite))
+                                       polarization, overwrite, notes[0])])
+    return ZemaxExport(_write_set(pairs, grids, targets, polarization, overwrite, notes))
 
 
 def _write_set(pairs: list[tuple[str | None, Model]], grids: list[ZemaxGrid],
-               targets: list[Path], polarization: Any, overwrite: bool) -> list[ZemaxFile]:
+               targets: list[Path], polarization: Any, overwrite: bool,
+               notes: list[list[str]]) -> list[ZemaxFile]:
     """The channels' files as one set (:class:`roughbrdf.output.ResultFolder`, added to the
     folder's set): a kill or an error leaves all the old files or all the new ones.
 
@@ -378,9 +387,9 @@ def _write_set(pairs: list[tuple[str | None, Model]], grids: list[ZemaxGrid],
             ResultFolder(targets[0].parent, overwrite=overwrite, extend=True,
                          adopt=[p.name for p in targets]) as out:
         out.check([p.name for p in targets])  # before the (slow) tables
-        for (label, mdl), grid, path in zip(pairs, grids, targets, strict=True):
+        for (label, mdl), grid, path, note in zip(pairs, grids, targets, notes, strict=True):
             tmp = Path(scratch) / path.name
-            done = _write_one(mdl, label, grid, tmp, polarization, True)
+            done = _write_one(mdl, label, grid, tmp, polarization, True, note)
             out.add(path.name, tmp.read_bytes())
             tmp.unlink()
             files.append(replace(done, path=path))
@@ -407,8 +416,8 @@ def _grid(model: Model, angles_of_incidence: Any, radial: Any, azimuth: Any, sym
 
 
 def _write_one(model: Model, label: str | None, grid: ZemaxGrid, path: Path,
-               polarization: Any, overwrite: bool) -> ZemaxFile:
-    """Evaluate, integrate and write one file."""
+               polarization: Any, overwrite: bool, notes: list[str]) -> ZemaxFile:
+    """Evaluate, integrate and write one file (``notes``: more header comments)."""
     values, counts = model_table(model, grid, polarization=polarization)
     tis = np.atleast_1d(np.asarray(albedo(model, np.radians(grid.aoi_deg),
                                           polarization=polarization), dtype=float))
@@ -422,7 +431,7 @@ def _write_one(model: Model, label: str | None, grid: ZemaxGrid, path: Path,
         "seen from above; AngleOfIncidence = theta_i = the specular angle",
         "TIS = the model's directional-hemispherical reflectance (roughbrdf.albedo); the "
         f"table's own integral is within {float(np.max(np.abs(integral - tis))):.2g} of it",
-        "directions below the horizon hold 0"]
+        "directions below the horizon hold 0", *notes]
     tis_all = np.broadcast_to(tis, grid.shape[:2])
     write_table(path, grid, values, tis_all, comments=comments, overwrite=overwrite)
     return ZemaxFile(Path(path), label, repr(model), grid, tis, integral, **counts)

@@ -22,11 +22,13 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from ..errors import ArgumentError
 
 if TYPE_CHECKING:
     from ..models import Model
@@ -34,7 +36,7 @@ if TYPE_CHECKING:
 
 __all__ = ["ALBEDO_INCIDENCES_DEG", "ENERGY_TOLERANCE", "EXPORT_INCIDENCES_DEG", "EnergyWarning",
            "Plausibility", "albedo_by_incidence", "channel_plausibility", "energy_gain",
-           "warn_energy"]
+           "refuse_energy_gain", "warn_energy"]
 
 #: incidences (degrees) of the albedo reported for every fitted channel
 ALBEDO_INCIDENCES_DEG: tuple[float, ...] = (0, 10, 20, 30, 40, 50, 60, 70, 80, 85)
@@ -67,6 +69,33 @@ def energy_gain(model: Model, theta_deg: Sequence[float] = EXPORT_INCIDENCES_DEG
         return None
     j = int(np.nanargmax(a))
     return float(theta_deg[j]), float(a[j])
+
+
+def refuse_energy_gain(models: Mapping[Any, Model], allow: Any) -> list[str]:
+    """Refuse to export a model that gains energy (:func:`energy_gain` over
+    :data:`EXPORT_INCIDENCES_DEG`), unless ``allow`` (``allow_energy_gain=True``).
+
+    ``models`` maps channel labels (None or ``""``: a model) to models. Raises an
+    :class:`~roughbrdf.errors.ArgumentError` of ``allow_energy_gain`` naming the channel, the
+    albedo and the incidence; with ``allow``, returns one line per such model for the file
+    written (Zemax comment, Mitsuba XML comment or JSON key), else ``[]``.
+    """
+    if not isinstance(allow, bool):  # a string "no" would be truthy
+        raise ArgumentError("allow_energy_gain", "must be True or False", value=allow)
+    notes = []
+    for label, m in models.items():
+        gain = energy_gain(m)
+        if gain is None:
+            continue
+        where = f" (channel {label})" if label not in (None, "") else ""
+        text = (f"the model{where} reflects more than it receives: albedo {gain[1]:.4g} at "
+                f"theta_i = {gain[0]:g} deg ({math.radians(gain[0]):.4g} rad), above "
+                f"1 + {ENERGY_TOLERANCE:g}")
+        if not allow:
+            raise ArgumentError("allow_energy_gain", text + "; not exported (not physical)",
+                                fix=True)
+        notes.append(f"allow_energy_gain: exported although {text}")
+    return notes
 
 
 @dataclass(frozen=True)

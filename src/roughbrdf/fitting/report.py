@@ -13,8 +13,8 @@ unit named, in radians (the library's unit, ``angles="rad"``, the default) or in
 always holds radians.
 
 Honest at bounds: a parameter at a bound (:func:`~roughbrdf.fitting.statistics.at_bound`) is
-printed ``(at the lower bound, a physical limit; no stderr)`` or ``(at the upper bound, a search
-limit: not a result; no stderr)`` (:func:`~roughbrdf.fitting.statistics.limit_kinds`) with a
+printed ``(at the lower bound: no stderr) [physical limit]`` or ``(at the upper bound: no
+stderr) [search limit: not a result]`` (:func:`~roughbrdf.fitting.statistics.limit_kinds`) with a
 note why (the covariance is not meaningful at an active bound); the ``[[Plausibility]]`` block
 gives the albedo by incidence and the model/data peak ratios
 (:mod:`~roughbrdf.fitting.plausibility`); a relative error is printed as a percentage only up
@@ -204,8 +204,8 @@ def _variable(c: ChannelFit, name: str, val: float | None, angle: str | None) ->
     side = c.at_bound.get(name)
     if side is not None:
         kind = c.limits.get(name, "search").split("-")[0]
-        what = ("search limit: not a result" if kind == "search" else "physical limit")
-        return f"{shown(val, 7)}{unit} (at the {side} bound, a {what}; no stderr) {tail}"
+        what = "search limit: not a result" if kind == "search" else "physical limit"
+        return f"{shown(val, 7)}{unit} (at the {side} bound: no stderr) [{what}] {tail}"
     se = c.stderr.get(name)
     return f"{shown(val, 7)}{unit} +/- {shown(se, 4)}{unit}{percent(se, val)} {tail}"
 

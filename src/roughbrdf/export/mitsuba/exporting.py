@@ -22,7 +22,8 @@ from .mapping import Leaf, leaves_of, merge_channels, note_for, plugin_tree, why
 from .stand_ins import describe, fit_closest
 from .xml_writer import xml_text
 
-__all__ = ["MitsubaExport", "TermExport", "export_mitsuba", "to_mitsuba", "to_mitsuba_xml"]
+__all__ = ["MitsubaExport", "TermExport", "export_mitsuba", "to_mitsuba", "to_mitsuba_xml",
+           "xml_comments"]
 
 #: a channel label naming a wavelength ("630nm"): RGB colours by wavelength
 _WAVELENGTH = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*nm\s*$", re.IGNORECASE)
@@ -82,6 +83,9 @@ class MitsubaExport:
     grid : tuple of numpy.ndarray
         ``(theta_i, theta_r, phi)`` of the deviation grid (:func:`deviation_grid`), for
         checking the reported deviations with Mitsuba.
+    notes : dict
+        ``{channel label: [line, ...]}``: the record of ``allow_energy_gain=True`` for each
+        model exported although it gains energy (written into the files, :func:`note_lines`).
     """
 
     bsdf: dict[str, Any]
@@ -91,6 +95,12 @@ class MitsubaExport:
     rgb: tuple[str, str, str] | None
     theta_max: float
     grid: tuple[np.ndarray, np.ndarray, np.ndarray] = field(repr=False)
+    notes: dict[str, list[str]] = field(default_factory=dict)
+
+    def note_lines(self, label: str | None = None) -> list[str]:
+        """The notes of channel ``label``, or of every channel (None)."""
+        return [n for key, lines in self.notes.items() if label is None or key == label
+                for n in lines]
 
     @property
     def status(self) -> str:
@@ -105,8 +115,9 @@ class MitsubaExport:
         :func:`mitsuba.load_string` loads as the BSDF.
         """
         if self.rule != "per-channel":
-            return xml_text(self.bsdf, id, version)
-        return "\n".join(xml_text(b, f"{id}-{label}" if id else label, version)
+            return xml_comments(self.note_lines()) + xml_text(self.bsdf, id, version)
+        return "\n".join(xml_comments(self.note_lines(label))
+                         + xml_text(b, f"{id}-{label}" if id else label, version)
                          for label, b in self.bsdf.items())
 
     def summary(self) -> str:
@@ -244,8 +255,15 @@ def _rgb_order(labels: list[str], rgb: Any) -> tuple[str, str, str] | None:
     return None
 
 
+def xml_comments(lines: list[str]) -> str:
+    """``<!-- line -->`` per line, each followed by a line break ("--" is not allowed in an
+    XML comment: spaced out)."""
+    return "".join(f"<!-- {' '.join(n.replace('--', '- -').split())} -->\n" for n in lines)
+
+
 def export_mitsuba(source: Any, *, channel: int | str | None = None, rgb: Any = None,
-                   fit: bool = False, theta_max: float = math.radians(80.0)) -> MitsubaExport:
+                   fit: bool = False, theta_max: float = math.radians(80.0),
+                   allow_energy_gain: bool = False) -> MitsubaExport:
     """Export a model or a fit to Mitsuba 3, with a record of how every term was mapped.
 
     Parameters
@@ -267,6 +285,12 @@ def export_mitsuba(source: Any, *, channel: int | str | None = None, rgb: Any = 
         a model raises ``ValueError`` with the reason.
     theta_max : float
         Largest ``theta_i``, ``theta_r`` (radians) of the deviation grid and the fits.
+    allow_energy_gain : bool
+        Export a model that reflects more than it receives (albedo above ``1 + 1e-3`` at an
+        incidence of 0, 5, ... 85, 89 deg; the roughbrdf model's albedo, not the mapped
+        BSDF's), recorded in :attr:`MitsubaExport.notes`; by default refused with an
+        :class:`~roughbrdf.errors.ArgumentError` naming the albedo and the incidence
+        (:func:`~roughbrdf.fitting.plausibility.refuse_energy_gain`).
 
     Returns
     -------
@@ -284,8 +308,12 @@ def export_mitsuba(source: Any, *, channel: int | str | None = None, rgb: Any = 
     """
     if not isinstance(fit, bool):
         raise ArgumentError("fit", "must be True or False", value=fit)
+    from ...fitting.plausibility import refuse_energy_gain
+
     grid = deviation_grid(theta_max)
     models, rule = _models_of(source, channel)
+    notes = {label: refuse_energy_gain({label: m}, allow_energy_gain)
+             for label, m in models.items()}
     if rule != "multi" and rgb not in (None, True, False):
         raise ArgumentError("rgb", "needs a fit with three channels or more (and no channel=)",
                             value=rgb)
@@ -313,11 +341,13 @@ def export_mitsuba(source: Any, *, channel: int | str | None = None, rgb: Any = 
             mitsuba_values(bsdf[label] if rule == "per-channel" else bsdf, *grid),
             np.asarray(m.brdf(*grid))) for label, m in models.items()}
     return MitsubaExport(bsdf=bsdf, rule=rule, terms={k: v[1] for k, v in per.items()},
-                         deviation=deviation, rgb=order, theta_max=float(theta_max), grid=grid)
+                         deviation=deviation, rgb=order, theta_max=float(theta_max), grid=grid,
+                         notes={k: v for k, v in notes.items() if v})
 
 
 def to_mitsuba(source: Any, *, channel: int | str | None = None, rgb: Any = None,
-               fit: bool = False, theta_max: float = math.radians(80.0)) -> dict[str, Any]:
+               fit: bool = False, theta_max: float = math.radians(80.0),
+               allow_energy_gain: bool = False) -> dict[str, Any]:
     """A model or fit as a Mitsuba 3 scene-description dict (:func:`mitsuba.load_dict`).
 
     One BSDF, or ``{channel: BSDF}`` for a fit whose channels are not one RGB BSDF (module
@@ -340,12 +370,14 @@ def to_mitsuba(source: Any, *, channel: int | str | None = None, rgb: Any = None
     ...
     roughbrdf.errors.ArgumentError: model 'microfacet' has no Mitsuba 3 counterpart: ...fit=True
     """
-    return export_mitsuba(source, channel=channel, rgb=rgb, fit=fit, theta_max=theta_max).bsdf
+    return export_mitsuba(source, channel=channel, rgb=rgb, fit=fit, theta_max=theta_max,
+                          allow_energy_gain=allow_energy_gain).bsdf
 
 
 def to_mitsuba_xml(source: Any, *, channel: int | str | None = None, rgb: Any = None,
                    fit: bool = False, theta_max: float = math.radians(80.0),
-                   id: str | None = None, version: str | None = None) -> str:  # noqa: A002
+                   id: str | None = None, version: str | None = None,  # noqa: A002
+                   allow_energy_gain: bool = False) -> str:
     """A model or fit as an XML ``<bsdf>`` element of a Mitsuba 3 scene file.
 
     Arguments as :func:`export_mitsuba`; ``id`` names the element (per-channel exports use
@@ -361,5 +393,6 @@ def to_mitsuba_xml(source: Any, *, channel: int | str | None = None, rgb: Any = 
       <float name="reflectance" value="0.5" />
     </bsdf>
     """
-    e = export_mitsuba(source, channel=channel, rgb=rgb, fit=fit, theta_max=theta_max)
+    e = export_mitsuba(source, channel=channel, rgb=rgb, fit=fit, theta_max=theta_max,
+                       allow_energy_gain=allow_energy_gain)
     return e.xml(id=id, version=version)

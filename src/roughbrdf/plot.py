@@ -27,6 +27,8 @@ function                   what it draws
 :func:`plot_comparison`    measurement vs model, in-plane slices, one colour per incidence
 :func:`plot_residual_map`  relative residual ``(data - model)/model``, one map per incidence
 =========================  ==================================================================
+
+A fit's figure (both, and what the fit left out) is :func:`roughbrdf.plot_fit.plot_fit`.
 """
 
 from __future__ import annotations
@@ -428,11 +430,12 @@ def _in_plane_slices(ax: Axes, model: Model, inplane: Measurement, k: float, cur
             yc = compared_values(model, float(t), tr_g, ph_g, curve_q, pol, aperture) / k
             ax.plot(_deg(ts_grid), yc, color=col, lw=1.2, ls="-" if gi == 0 else "--",
                     label=rf"model $\theta_i$ = {math.degrees(t):.3g}°{pname}")
-            # the peak within the data's span (a model may diverge toward grazing, where no
-            # sample says anything), plus the model at the samples (a peak between grid points)
-            span = (_deg(ts_grid) >= x.min()) & (_deg(ts_grid) <= x.max())
-            at = compared_values(model, sub.theta_i, sub.theta_r, sub.phi, curve_q, pol,
-                                 aperture) / k
+            # the peak over the data's span and specular (a model may diverge toward grazing, where
+            # no sample says anything); at the samples and specular too (a peak between grid points)
+            lo_x, hi_x = min(x.min(), math.degrees(t)), max(x.max(), math.degrees(t))
+            span = (_deg(ts_grid) >= lo_x) & (_deg(ts_grid) <= hi_x)
+            at = compared_values(model, np.append(sub.theta_i, t), np.append(sub.theta_r, t),
+                                 np.append(sub.phi, 0.0), curve_q, pol, aperture) / k
             both = np.concatenate([yc[span], np.atleast_1d(at)])
             if np.isfinite(both).any():
                 peaks.append(float(np.nanmax(np.where(np.isfinite(both), both, np.nan))))
@@ -511,8 +514,7 @@ def relative_residuals(model: Model, measurement: Measurement, *, channel: int |
 
 
 def _panel_grid(fig: Figure, ax: Axes, n: int) -> list[Axes]:
-    """``n`` panels in the place of ``ax`` in its figure (``ax`` the first), in the grid of
-    columns that gives the largest square panels."""
+    """``n`` panels in ``ax``'s place (``ax`` the first), in the grid of largest panels."""
     spec = ax.get_subplotspec()
     if spec is None:  # an axes placed by hand (add_axes) has no grid cell to divide
         raise ValueError("ax must be a subplot (fig.add_subplot) to hold the residual panels")
@@ -525,17 +527,15 @@ def _panel_grid(fig: Figure, ax: Axes, n: int) -> list[Axes]:
 
 
 def _degree_disk(ax: Axes) -> None:
-    """Circles at theta_r = 30, 60, 90 deg and the plane of incidence of a residual panel,
-    whose axes are ``theta_r cos(phi)`` and ``theta_r sin(phi)`` in degrees."""
+    """Circles at theta_r = 30, 60, 90 deg on a panel of axes theta_r cos/sin(phi) [deg]."""
     t = np.linspace(0, 2 * math.pi, 361)
     for deg in (30, 60, 90):
         ax.plot(deg * np.cos(t), deg * np.sin(t), color="0.6", lw=0.6 if deg < 90 else 1.0)
     ax.axhline(0, color="0.6", lw=0.5)
     ax.set_aspect("equal")
-    ax.set_xlim(-95, 95)
-    ax.set_ylim(-95, 95)
-    ax.set_xticks([-90, -60, -30, 0, 30, 60, 90])
-    ax.set_yticks([-90, -60, -30, 0, 30, 60, 90])
+    ax.set(xlim=(-95, 95), ylim=(-95, 95))
+    ax.set_xticks(np.arange(-90, 91, 30))
+    ax.set_yticks(np.arange(-90, 91, 30))
     ax.tick_params(labelsize="x-small")
 
 

@@ -13,6 +13,7 @@ drawn, not with this module.
 
 from __future__ import annotations
 
+import textwrap
 from typing import TYPE_CHECKING, Any
 
 from . import plot as rbplot
@@ -68,6 +69,7 @@ def plot_fit(model: Model, measurement: Measurement, *, channel: int | str = 0,
                                       aperture=aperture)
     if title:
         fig.suptitle(title, fontsize="medium")
-    if note:
-        fig.supxlabel(note, fontsize="small")
+    if note:  # wrapped to the figure's width (about 12 characters an inch at this size)
+        fig.supxlabel(textwrap.fill(note, max(40, int(12 * fig.get_figwidth()))),
+                      fontsize="small")
     return fig, (ax1, ax2)

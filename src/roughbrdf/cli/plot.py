@@ -189,7 +189,9 @@ def _fit_samples(fit: dict[str, Any], chan: dict[str, Any], meas: Any, ch: int, 
     from ..fitting.data import Comparison, DataOptions, excluded_text, prepare_channel
     from ..quantity import Quantity
 
-    o = fit.get("options") or {}
+    o = fit.get("options")
+    if not isinstance(o, dict):  # a fit.json of an older roughbrdf, or edited: the defaults
+        o = {}
     weights = o.get("weights")
     opts = DataOptions(Comparison.of(meas, fit.get("relative_to")), fit.get("loss") or "relative",
                        "uncertainty" if weights == "uncertainty" else None,

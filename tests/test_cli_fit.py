@@ -25,7 +25,7 @@ def _fit(*args):
 def test_fit_writes_json_report_and_plots(tmp_path):
     out = tmp_path / "out"
     res = _fit(DEFAULT, "--model", "trowbridge-reitz-1975", "--starts", "2", "--out", out)
-    assert res.exit_code == 0, res.output
+    assert res.exit_code == 1 and "warning:" in res.output, res.output  # TR75: albedo > 1
     assert "[[Fit]] trowbridge-reitz-1975" in res.output and "TR75 sigma" in res.output
     d = json.loads((out / "fit.json").read_text())
     assert d["model"] == "trowbridge-reitz-1975" and d["loss"] == "relative"
@@ -46,7 +46,7 @@ def test_sum_model_with_parameters_fix_and_loss(tmp_path):
     res = _fit(DEFAULT, "-m", "trowbridge-reitz-1975+lambertian", "-p", "tr75_rho_L=0",
                "--fix", "rho_L", "-p", "rho=0.2", "--loss", "log", "--starts", "2", "--out",
                out, "--no-plots", "-q")
-    assert res.exit_code == 0, res.output
+    assert res.exit_code == 1 and "warning:" in res.output, res.output  # TR75: albedo > 1
     assert "[[Fit]]" not in res.output  # --quiet
     d = json.loads((out / "fit.json").read_text())
     assert d["model"] == "trowbridge-reitz-1975+lambertian" and d["loss"] == "log"
@@ -127,12 +127,12 @@ def test_never_overwrites_foreign_files(tmp_path):
     assert (out / "fit.json").read_text() == "{}"
     (out / "fit.json").unlink()  # the user moves it away
     res = _fit(*args)
-    assert res.exit_code == 0, res.output
+    assert res.exit_code == 1 and "warning:" in res.output, res.output  # TR75: albedo > 1
     res = _fit(*args)  # the folder holds results now: a second run asks for --force
     assert res.exit_code == 2 and "holds results already" in res.output
     assert "--force" in res.output and "overwrite=True" not in res.output
     res = _fit(*args, "--force")  # and replaces them with it
-    assert res.exit_code == 0, res.output
+    assert res.exit_code == 1 and "warning:" in res.output, res.output  # TR75: albedo > 1
     assert (out / "notes.txt").read_text() == "keep"
     assert json.loads((out / "fit.json").read_text())["model"] == "trowbridge-reitz-1975"
 
@@ -141,7 +141,7 @@ def test_aperture_option_recorded_in_json_and_report(tmp_path):
     out = tmp_path / "ap"
     res = _fit(DEFAULT, "--model", "trowbridge-reitz-1975", "--starts", "1", "--aperture", "2",
                "--out", out, "--no-plots")
-    assert res.exit_code == 0, res.output
+    assert res.exit_code == 1 and "warning:" in res.output, res.output  # TR75: albedo > 1
     assert "aperture           = 2 deg half-angle, uniform cone about w_r" in res.output
     d = json.loads((out / "fit.json").read_text())
     assert d["aperture"]["half_angle_deg"] == pytest.approx(2.0)
@@ -150,7 +150,7 @@ def test_aperture_option_recorded_in_json_and_report(tmp_path):
     assert d["options"]["aperture"] == pytest.approx(math.radians(2.0))
     plain = _fit(DEFAULT, "--model", "trowbridge-reitz-1975", "--starts", "1", "--out",
                  tmp_path / "plain", "--no-plots", "-q")
-    assert plain.exit_code == 0, plain.output
+    assert plain.exit_code == 1, plain.output  # TR75: albedo > 1
     assert json.loads((tmp_path / "plain" / "fit.json").read_text())["aperture"] is None
 
 
@@ -196,7 +196,7 @@ def test_bounds_option(tmp_path):
     out = tmp_path / "b"
     res = _fit(DEFAULT, "-m", "tr75", "--bounds", "e=0.1:0.5", "--bounds", "rho_L=0.2:0.6",
                "--starts", "2", "--no-plots", "-q", "--out", out)
-    assert res.exit_code == 0, res.output
+    assert res.exit_code == 1 and "warning:" in res.output, res.output  # TR75: albedo > 1
     params = json.loads((out / "fit.json").read_text())["channels"][0]["params"]
     assert 0.1 <= params["e"] <= 0.5 and params["e"] == pytest.approx(0.5, abs=1e-6)  # true 0.68
     m = build_model("trowbridge-reitz-1975+lambertian")
@@ -230,7 +230,7 @@ def test_angles_in_option(tmp_path):
     assert res.exit_code == 2 and "angle" in res.output  # the reader's message (roughbrdf.io)
     res = _fit(path, "-m", "tr75", "--angles-in", "deg", "--starts", "1", "--no-plots", "-q",
                "--out", tmp_path / "a")
-    assert res.exit_code == 0, res.output
+    assert res.exit_code == 1 and "warning:" in res.output, res.output  # TR75: albedo > 1
     d = json.loads((tmp_path / "a" / "fit.json").read_text())
     assert d["channels"][0]["params"]["e"] == pytest.approx(0.68, abs=0.05)
     res = _fit(path, "-m", "tr75", "--angles-in", "grad", "--out", tmp_path / "b")
@@ -256,7 +256,7 @@ def test_quantity_takes_every_spelling(tmp_path, monkeypatch):
     for spelling in ("RELATIVE", "relative"):
         res = _fit(DEFAULT, "-m", "tr75", "--quantity", spelling, "--starts", "1", "-q",
                    "--no-plots", "--out", tmp_path / spelling)
-        assert res.exit_code == 0, res.output
+        assert res.exit_code == 1 and "warning:" in res.output, res.output  # TR75: albedo > 1
     assert seen == ["relative", "relative"]
     res = _fit(DEFAULT, "-m", "tr75", "--quantity", "radiance", "--out", tmp_path / "x")
     assert res.exit_code == 2
@@ -292,7 +292,7 @@ def test_force_replaces_the_whole_earlier_set(tmp_path):
     word and left the old PNG beside them; now it asks for --force, which replaces the set."""
     out = tmp_path / "o"
     res = _fit(DEFAULT, "-m", "tr75", "--starts", "1", "-q", "--out", out)
-    assert res.exit_code == 0, res.output
+    assert res.exit_code == 1 and "warning:" in res.output, res.output  # TR75: albedo > 1
     assert (out / "fit_relative.png").is_file()
     again = (DEFAULT, "-m", "ts67", "-p", "n=None", "--fix", "rho_d", "--starts", "1", "-q",
              "--no-plots", "--out", out)

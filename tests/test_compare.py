@@ -144,7 +144,8 @@ def test_table_to_dict_and_plot(comparison):
     assert [r["model"] for r in d["candidates"]] == [c.label for c in comparison.candidates]
     row = d["candidates"][0]
     assert set(row) == {"model", "k", "n_points", "aic", "bic", "sigma", "rms_log",
-                        "rms_log_by_theta_r", "cv", "params", "elapsed_s"}
+                        "rms_log_by_theta_r", "cv", "params", "limits", "plausibility",
+                        "elapsed_s"}
     assert set(row["params"]) == {"c0", "c1"} and set(row["params"]["c0"]) == {
         "n", "rho", "alpha", "ks"}
     json.dumps(d)  # plain values

@@ -96,7 +96,7 @@ def loaded(e):
 
 def check_exact(model, seed: int, reference=None, rtol: float = RTOL, status: str = "exact"):
     """Mitsuba (dict and XML) against ``reference`` (default: the model) at N geometries."""
-    e = export_mitsuba(model)
+    e = export_mitsuba(model, allow_energy_gain=True)  # the mapping is tested, not the albedo
     assert e.status == status, e.summary()
     angles, wi, wo = geometry(seed)
     ref = (reference or model).brdf(*angles)
@@ -298,7 +298,7 @@ FITTED = [
 
 @pytest.mark.parametrize("model", FITTED, ids=[m.name for m in FITTED])
 def test_fitted_export_reports_mitsubas_deviation(model):
-    e = export_mitsuba(model, fit=True)
+    e = export_mitsuba(model, fit=True, allow_energy_gain=True)  # RB08's albedo exceeds 1
     assert e.status == "fitted" and e.terms[""][0].fitted is not None
     actual = reported_matches_mitsuba(e, model)
     assert actual.rms < 0.25
@@ -310,7 +310,9 @@ def test_fitted_export_reports_mitsubas_deviation(model):
 
 def test_tr75_fitted_on_request():
     m = rb.model("tr75", e=0.3, n=1.5, k=0.0, rho_L=0.2)
-    mapped, fitted = export_mitsuba(m), export_mitsuba(m, fit=True)
+    # TR75 has no shadowing: its albedo exceeds 1 at grazing incidence
+    mapped = export_mitsuba(m, allow_energy_gain=True)
+    fitted = export_mitsuba(m, fit=True, allow_energy_gain=True)
     assert fitted.status == "fitted"
     actual = reported_matches_mitsuba(fitted, m)
     assert actual.rms < mapped.deviation[""].rms

@@ -312,8 +312,6 @@ def export_mitsuba(source: Any, *, channel: int | str | None = None, rgb: Any = 
 
     grid = deviation_grid(theta_max)
     models, rule = _models_of(source, channel)
-    notes = {label: refuse_energy_gain({label: m}, allow_energy_gain)
-             for label, m in models.items()}
     if rule != "multi" and rgb not in (None, True, False):
         raise ArgumentError("rgb", "needs a fit with three channels or more (and no channel=)",
                             value=rgb)
@@ -321,6 +319,9 @@ def export_mitsuba(source: Any, *, channel: int | str | None = None, rgb: Any = 
     if order is not None and rgb not in (None, True):
         models = {label: models[label] for label in order}  # explicit: those three only
     per = {label: _export_model(m, fit, grid) for label, m in models.items()}
+    # after the mapping: a model Mitsuba cannot express is refused for that reason first
+    notes = {label: refuse_energy_gain({label: m}, allow_energy_gain)
+             for label, m in models.items()}
     merged = merge_channels([per[label][0] for label in order]) if order is not None else None
     if isinstance(merged, str) and rgb not in (None, True):
         raise ValueError(f"rgb={rgb!r}: the channels cannot be one RGB BSDF: {merged}; pass "

@@ -9,8 +9,10 @@ results stops the command before any work unless ``--force`` (replace) or ``--re
 the inputs whose complete results exist for the same input bytes, model and options; redo the
 rest). ``--time-limit S`` fails a task that runs longer than S seconds.
 
-Exit status 1 when a file failed (its error is printed, the others are fitted) or a fit did not
-converge; 130 on Ctrl-C (finished fit folders are complete, no catalogue file is written).
+Exit status 1 when a file failed (its error is printed, the others are fitted) or a fit is not
+to be trusted without a look: it did not converge, a parameter ended on a search limit or the
+model gains energy (row statuses ``not converged``, ``at-search-limit``, ``gains-energy``);
+130 on Ctrl-C (finished fit folders are complete, no catalogue file is written).
 """
 
 from __future__ import annotations
@@ -124,8 +126,8 @@ class BatchRun:
 
 def run_batch(paths: list[str], out: str, given: ModelInput, options: FitOptions,
               run: BatchRun) -> int:
-    """The work of ``roughbrdf fit-batch``; the exit status (0, or 1 if a file failed or a fit
-    did not converge). Options are checked before any cluster starts."""
+    """The work of ``roughbrdf fit-batch``; the exit status (0, or 1 if a file failed or a row's
+    status is not ``ok``: module notes). Options are checked before any cluster starts."""
     from ..catalogue import fit_catalogue
 
     m, options = resolve_model(given, options)

@@ -51,8 +51,10 @@ from .fit import fit
 from .objective import Objective, ObjectiveSpec
 from .options import FitOptions
 from .plan import FitPlan
+from .plausibility import EnergyWarning
 from .result import ChannelFit, FitResult
 
 __all__ = ["fit", "FitOptions", "compare", "fit_auto", "AUTO_CANDIDATES", "ModelComparison",
            "FitResult", "ChannelFit", "FitPlan", "LOSSES", "Loss", "APERTURE_POINTS",
-           "aperture_stencil", "aperture_average", "ChannelData", "Objective", "ObjectiveSpec"]
+           "aperture_stencil", "aperture_average", "ChannelData", "Objective", "ObjectiveSpec",
+           "EnergyWarning"]

@@ -55,8 +55,10 @@ def _micro_eval(ti, tr, phi, gamma, p, flag, dcode, scode):
     else:
         geo = shd.g_over_cos_cos(scode, dcode, alpha, ci, cr, hz, cd)
     t = ks * f * d
-    # t = 0 (F = 0, or D underflowed far from its peak) gives 0 there, never 0 * inf
-    return 0.25 * t * geo if t > 0.0 else 0.0
+    # t = 0 (F = 0, or D underflowed far from its peak) gives 0 there, never 0 * inf; t * geo
+    # first: 0.25 * t of a subnormal t rounds to 0, and 0 * inf (unshadowed, grazing) is NaN
+    # (scaling by 0.25 is exact otherwise, so the order changes no other value)
+    return 0.25 * (t * geo) if t > 0.0 else 0.0
 
 
 @driver

@@ -237,9 +237,9 @@ def test_x():
 """,
     "a name or field of a time span": """
 def test_x(res, row):
-    assert res.duration <= 1.0
+    assert res.duration <=1.0
     assert row["elapsed_s"] < 5
-    assert took < 2
+    assert took <2
 """,
 }
 

@@ -61,9 +61,13 @@ def cluster():
     """An existing cluster (2 single-threaded worker processes), reached by its address."""
     from distributed import LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as c:
+    from roughbrdf.catalogue.run import close_local
+
+    c = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+    try:
         yield c
+    finally:  # bounded: a plain close can wait for ever once a worker was killed (CI, load)
+        close_local(c)
 
 
 def _same_as_rb_fit(rows, paths):

@@ -8,6 +8,7 @@ worker processes.
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 import textwrap
@@ -149,3 +150,31 @@ def test_library_checks_options_before_any_cluster(data, tmp_path, monkeypatch, 
         fit_catalogue([data], "tr75", tmp_path / "cat", progress=False, **options)
     assert err.value.argument == argument
     assert not (tmp_path / "cat").exists()
+
+
+def test_close_local_kills_the_workers_of_a_cluster_that_does_not_close():
+    # a cluster whose close times out (a nanny that no longer answers): its worker processes are
+    # killed and the call returns; another child of the caller's is left alone
+    from types import SimpleNamespace
+
+    from roughbrdf.catalogue.run import close_local
+
+    worker = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(600)"])
+    other = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(600)"])
+    closed: list = []
+
+    def hangs(timeout):
+        closed.append(timeout)
+        raise TimeoutError("close timed out")
+
+    try:
+        cluster = SimpleNamespace(workers={"w": SimpleNamespace(pid=worker.pid), "x": object()},
+                                  close=hangs)
+        close_local(cluster, timeout=0.5)
+        assert closed == [0.5]
+        assert worker.wait(10) == -signal.SIGKILL
+        assert other.poll() is None
+    finally:
+        for p in (worker, other):
+            p.kill()
+            p.wait()

@@ -24,7 +24,7 @@ from typing import Any
 from .rows import failed_row
 from .tasks import Task, run_task
 
-__all__ = ["run_tasks", "connect", "start_local", "STARTED_HOOKS", "CONNECTED_HOOKS"]
+__all__ = ["run_tasks", "connect", "start_local", "close_local", "STARTED_HOOKS", "CONNECTED_HOOKS"]
 
 #: seconds between two looks at the running tasks (time limits, progress)
 POLL = 0.2
@@ -77,9 +77,40 @@ def connect(client: Any = None, scheduler: str | None = None,
                 _call(CONNECTED_HOOKS, c)
                 yield c, True
         finally:
-            cluster.close()
+            close_local(cluster)
     finally:
         _restore_environ(saved)
+
+
+#: seconds a local cluster has to close before its worker processes are killed
+CLOSE_TIMEOUT = 60.0
+
+
+def close_local(cluster: Any, timeout: float = CLOSE_TIMEOUT) -> None:
+    """Close a local cluster of ours within ``timeout`` seconds, whatever its workers do.
+
+    ``LocalCluster.close()`` without a timeout can wait for ever when a nanny does not answer
+    (a loaded machine after a worker was killed and restarted): the results are written by
+    then, so the call must end. After ``timeout`` the cluster's worker processes still alive
+    are killed (only those: the nannies' processes, never another child of the caller's).
+    """
+    import signal
+
+    pids = {pid for pid in (_worker_pid(w) for w in dict(cluster.workers).values()) if pid}
+    try:
+        cluster.close(timeout=timeout)
+    except Exception:  # a timeout or a comm error: the processes still alive are ended below
+        for pid in pids:
+            with contextlib.suppress(OSError):  # already gone
+                os.kill(pid, signal.SIGKILL)
+
+
+def _worker_pid(nanny: Any) -> int | None:
+    """The pid of a nanny's worker process (None when it has none)."""
+    try:
+        return int(nanny.pid) if nanny.pid else None
+    except (AttributeError, TypeError, ValueError):  # a worker without a nanny, or not started
+        return None
 
 
 def start_local(n: int, spawn: dict[str, str]) -> Any:

@@ -53,7 +53,7 @@ def test_compare_writes_the_three_files(files, tmp_path):
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
         "compare.json", "compare.md", "compare.png"]
     d = json.loads((out / "compare.json").read_text())
-    assert d["best"] == d["best_cv"] == "coated" and d["criterion"] == "bic"
+    assert d["best"] == d["best_cv"] == "coated" and d["criterion"] == "cv"
     assert [r["model"] for r in d["candidates"]] == ["coated", "lambertian"]
     assert all(r["cv"] is not None for r in d["candidates"])
     # the same figures as the library's comparison of the same file

@@ -63,10 +63,11 @@ def comparison(meas):
 
 
 def test_compare_picks_the_true_model_by_bic_and_cv(comparison):
-    assert comparison.best.label == "coated"
-    assert comparison.best_cv is comparison.best
-    bics = [c.bic for c in comparison.candidates]
-    assert bics == sorted(bics)
+    assert comparison.best.label == "coated" and comparison.criterion == "cv"
+    assert comparison.best_cv is comparison.best is comparison.best_bic
+    cvs = [c.cv for c in comparison.candidates]  # ranked by the score (none gains energy)
+    assert cvs == sorted(cvs)
+    assert not any(c.gains_energy for c in comparison.candidates)
     assert {c.label for c in comparison.candidates} == {"lambertian", "oren-nayar", "coated"}
     for c in comparison.candidates:
         assert c.cv is not None and math.isfinite(c.cv)
@@ -139,8 +140,8 @@ def test_cross_validation_needs_two_incidences():
 
 def test_table_to_dict_and_plot(comparison):
     d = comparison.to_dict()
-    assert set(d) == {"best", "best_cv", "criterion", "candidates", "notes"}
-    assert d["best"] == d["best_cv"] == "coated" and d["criterion"] == "bic"
+    assert set(d) == {"best", "best_cv", "best_bic", "criterion", "candidates", "notes"}
+    assert d["best"] == d["best_cv"] == d["best_bic"] == "coated" and d["criterion"] == "cv"
     assert [r["model"] for r in d["candidates"]] == [c.label for c in comparison.candidates]
     row = d["candidates"][0]
     assert set(row) == {"model", "k", "n_points", "aic", "bic", "sigma", "rms_log",
@@ -161,7 +162,9 @@ def test_table_to_dict_and_plot(comparison):
 def test_without_cv():
     cmp = rb.compare(_measurement(), "lambertian; coated", cv=False, starts=STARTS)
     assert [c.cv for c in cmp.candidates] == [None, None] and cmp.best_cv is None
-    assert cmp.to_dict()["best_cv"] is None
+    assert cmp.to_dict()["best_cv"] is None and cmp.criterion == "bic"
+    bics = [c.bic for c in cmp.candidates]  # without a score: ranked by BIC
+    assert bics == sorted(bics) and cmp.best is cmp.best_bic
     assert "| - |" in cmp.table().splitlines()[2]
 
 
@@ -190,8 +193,8 @@ def test_fit_auto_attaches_the_model_choice(tmp_path):
     d = json.loads(res.to_json())
     assert d["model"] == "coated" and d["model_choice"]["best"] == "coated"
     assert len(d["model_choice"]["candidates"]) == len(AUTO_CANDIDATES)
-    assert "[[Model choice]] candidates sorted by BIC (best first; chosen: coated)" in \
-        res.report()
+    assert "[[Model choice]] candidates sorted by cross-validation score (best first; chosen: "\
+        "coated)" in res.report()
     assert "compare.png" in res.files(plots=True)
     assert "compare.png" not in res.files(plots=False)
     written = res.save(tmp_path / "out", plots=False)
@@ -262,3 +265,39 @@ def test_compare_bad_candidates(cands):
     with pytest.raises(ArgumentError) as info:
         rb.compare(_measurement(), cands, cv=False, starts=1)
     assert info.value.argument == "candidates"
+
+
+def _candidate(label: str, cv: float | None, bic: float, albedo: float = 0.5):
+    """A Candidate of a stand-in result (one channel of the given maximum albedo): the
+    ranking reads only the score, the BIC and the albedo."""
+    from types import SimpleNamespace
+
+    from roughbrdf.fitting.compare import Candidate
+
+    plaus = SimpleNamespace(max_albedo=albedo)
+    res = SimpleNamespace(channels=[None], plausibility=lambda i: plaus)
+    return Candidate(label, res, 3, 100, bic, bic, 0.1, 0.1, {}, cv)
+
+
+def test_rank_by_score_bic_beside_energy_gain_last():
+    from roughbrdf.fitting.compare import ModelComparison, rank
+
+    # the issue's case: the lowest BIC predicts the left-out incidences worst
+    rows = [_candidate("a", 1.36, -900.0), _candidate("b", 0.52, -500.0),
+            _candidate("c", 0.40, -950.0, albedo=4.0), _candidate("d", 0.77, -600.0)]
+    ranked, criterion = rank(rows)
+    assert criterion == "cv"
+    assert [c.label for c in ranked] == ["b", "d", "a", "c"]  # c gains energy: last
+    cmp = ModelComparison(ranked, None, criterion=criterion)  # type: ignore[arg-type]
+    assert cmp.best.label == "b" and cmp.best_bic.label == "c" and cmp.best_cv.label == "c"
+    from roughbrdf.fitting.compare import choice_notes
+
+    notes = choice_notes(cmp)
+    assert any("ranked by cross-validation: b" in n and "BIC prefers c" in n for n in notes)
+    assert any("gains energy rank last" in n for n in notes)
+    # one candidate without a score: all by BIC (a score for some only is not comparable)
+    ranked, criterion = rank([_candidate("a", 0.3, -10.0), _candidate("b", None, -20.0)])
+    assert criterion == "bic" and [c.label for c in ranked] == ["b", "a"]
+    # NaN (a single incidence) is no score either
+    ranked, criterion = rank([_candidate("a", math.nan, -10.0), _candidate("b", 0.1, -5.0)])
+    assert criterion == "bic" and [c.label for c in ranked] == ["a", "b"]

@@ -184,7 +184,7 @@ def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model
     inputs : path, folder, glob pattern, or a list of them
         The measurement files (:func:`expand_inputs`).
     model : Model or str
-        As for :func:`roughbrdf.fit` (``"auto"``: the lowest BIC of ``candidates``).
+        As for :func:`roughbrdf.fit` (``"auto"``: the best of ``candidates`` by cross-validation).
     out_dir : path
         The catalogue folder: one fit folder per input (named by :func:`folder_names`),
         ``catalogue.csv`` and ``catalogue.json``.

@@ -32,7 +32,8 @@ FILES = ("compare.md", "compare.json", "compare.png")
 def run_compare(file: str, models: str | None, out: str | None, options: FitOptions,
                 read: ReadInput, *, force: bool, plots: bool, cv: bool) -> int:
     """The work of ``roughbrdf compare``; returns the exit status (0, or 1 if a candidate's fit
-    did not converge, or the best candidate (lowest BIC) has a parameter on a search limit or
+    did not converge, or the best candidate (by the cross-validation score; BIC with
+    ``--no-cv``) has a parameter on a search limit or
     gains energy: one ``warning:`` line each)."""
     from ..fitting.compare import compare
     from ..jsonsafe import clean_json

@@ -17,7 +17,8 @@ source_exclusion=)`` in radians), ``--no-plots`` skips the figures (and
 Matplotlib). ``--bounds NAME=LOW:HIGH`` overrides a parameter's search range; ``--angles-in``
 states the angle unit of an ASTM or CSV file that does not. ``--model auto`` fits the
 candidates of ``roughbrdf.fitting.compare.AUTO_CANDIDATES`` (or those of ``--models``) and keeps
-the lowest BIC, with the comparison in ``fit.json``, the report and ``compare.png``
+the best by leave-one-incidence-out prediction, with the comparison in ``fit.json``, the report
+and ``compare.png``
 (``--no-cv``: without the leave-one-incidence-out score). ``--joint`` fits all channels at
 once with the roughness and index shared (``--shared NAME`` chooses), ``--keep-extrapolated``
 also fits the values a file holds beyond the instrument's range (``rb.fit(...,
@@ -304,7 +305,8 @@ FIT_OWN: dict[str, tuple[Any, Any]] = {
     "model": (Annotated[str, typer.Option(
         "--model", "-m", help="model name, spec or sum, e.g. trowbridge-reitz-1975, "
                               "coated(lobes=2) or microfacet+lambertian (aliases: roughbrdf "
-                              "models); auto: the lowest BIC of the candidates (--models)")],
+                              "models); auto: the candidate that predicts left-out incidences "
+                              "best (--models)")],
               inspect.Parameter.empty),
     "out": (Annotated[str, typer.Option("--out", "-o", help="output folder (refused if it "
                                                              "holds results, unless --force)")],

@@ -4,8 +4,13 @@
 with the same options and tabulates, per candidate: the parameters, TR75's sigma and the rms-log
 (medians over the channels), AIC and BIC, the rms-log by band of ``theta_r`` and, unless
 ``cv=False``, a leave-one-incidence-out cross-validation score. ``roughbrdf fit FILE --model
-auto`` fits :data:`AUTO_CANDIDATES` and keeps the lowest BIC (``docs/fitting.md``, "Model
-choice").
+auto`` fits :data:`AUTO_CANDIDATES` and keeps the best by prediction (``docs/fitting.md``,
+"Model choice").
+
+**Ranking** (:func:`rank`): by the cross-validation score when it was computed (the default),
+by BIC otherwise (``cv=False``, or a single incidence); a candidate whose fitted model gains
+energy (albedo above 1 + 1e-3 at some incidence) ranks after every one that does not. BIC is
+reported beside the score, and a note says when BIC would choose another candidate.
 
 Information criteria of a candidate over all its channels (channel ``c``: ``n_c`` samples,
 ``chi2_c`` the sum of its squared loss residuals; ``N = sum n_c``; ``k`` the fitted unknowns of
@@ -24,7 +29,10 @@ Cross-validation (``cv``): for each channel and each incidence angle of the file
 the candidate is refitted without that incidence (one local fit started from the full fit's
 optimum, same options) and its loss residuals on the left-out samples are collected; the score
 is their r.m.s. over every fold and channel (unweighted; the left-out samples are those the
-full fit used).
+full fit used). Why leave-one-incidence-out: a user relies on the model at incidences the
+instrument did not measure (a ray tracer asks for every angle), and the folds follow how a
+goniometer's samples are correlated -- along one incidence's scan -- so a fold's samples are
+not predicted from their neighbours (``docs/fitting.md``, "Model choice", gives the numbers).
 """
 
 from __future__ import annotations
@@ -44,13 +52,14 @@ from ..quantity import Loss
 from .channels import fit_model
 from .options import FitOptions
 from .plausibility import ENERGY_TOLERANCE, EnergyWarning, warn_energy
+from .search import progress_bar
 
 if TYPE_CHECKING:
     from ..measurement import Measurement
     from .result import FitResult
 
-__all__ = ["AUTO_CANDIDATES", "THETA_R_BANDS", "Candidate", "ModelComparison", "compare",
-           "cross_validate", "fit_auto", "information"]
+__all__ = ["AUTO_CANDIDATES", "THETA_R_BANDS", "Candidate", "ModelComparison", "choice_notes",
+           "compare", "cross_validate", "fit_auto", "information", "rank"]
 
 #: the candidates of ``--model auto`` for non-retroreflective materials (paints, plastics,
 #: coatings, ceramics): TR75 as published, then the coated model with one and two specular
@@ -135,18 +144,38 @@ class Candidate:
                        if k.startswith("search")})
 
 
+    @property
+    def gains_energy(self) -> bool:
+        """Whether a fitted model of the candidate reflects more than it receives."""
+        return self.max_albedo > 1 + ENERGY_TOLERANCE
+
+
 @dataclass
 class ModelComparison:
-    """The result of :func:`compare`: the candidates, best first by BIC."""
+    """The result of :func:`compare`: the candidates, best first (:func:`rank`).
+
+    Attributes
+    ----------
+    candidates : list of Candidate
+        Best first by ``criterion``.
+    criterion : {"cv", "bic"}
+        What ranked them: the leave-one-incidence-out score, or BIC without one.
+    """
 
     candidates: list[Candidate]
     measurement: Measurement = field(repr=False)
     notes: list[str] = field(default_factory=list)
+    criterion: str = "bic"
 
     @property
     def best(self) -> Candidate:
-        """The lowest BIC."""
+        """The first candidate: the best by :attr:`criterion`."""
         return self.candidates[0]
+
+    @property
+    def best_bic(self) -> Candidate:
+        """The lowest BIC (which may not be :attr:`best`)."""
+        return min(self.candidates, key=lambda c: c.bic)
 
     @property
     def best_cv(self) -> Candidate | None:
@@ -161,7 +190,7 @@ class ModelComparison:
                 *[f"rms-log {b}" for b in bands], "max albedo", "peak ratio", "search limit",
                 "time (s)"]
         lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-        b0, a0 = self.best.bic, min(c.aic for c in self.candidates)
+        b0, a0 = self.best_bic.bic, min(c.aic for c in self.candidates)
         for c in self.candidates:
             cells = [c.label, str(c.k), f"{c.sigma:.3f}", f"{c.rms_log:.3f}",
                      f"{c.bic - b0:.0f}", f"{c.aic - a0:.0f}",
@@ -175,11 +204,11 @@ class ModelComparison:
         return "\n".join(lines + [""] + [f"- {n}" for n in self.notes])
 
     def to_dict(self) -> dict[str, Any]:
-        """``{"best", "best_cv", "criterion", "candidates": [row...], "notes"}``."""
+        """``{"best", "best_cv", "best_bic", "criterion", "candidates": [row...], "notes"}``."""
         cv = self.best_cv
         return {"best": self.best.label, "best_cv": None if cv is None else cv.label,
-                "criterion": "bic", "candidates": [c.row() for c in self.candidates],
-                "notes": list(self.notes)}
+                "best_bic": self.best_bic.label, "criterion": self.criterion,
+                "candidates": [c.row() for c in self.candidates], "notes": list(self.notes)}
 
     def plot(self, *, fig: Any = None) -> Any:
         """rms-log by theta_r band for each candidate (lines), and BIC differences (bars)."""
@@ -196,7 +225,7 @@ class ModelComparison:
         ax1.set_ylabel("rms of ln(data/model)")
         ax1.legend(fontsize=7)
         ax1.set_title(self.measurement.meta.get("sample") or "model comparison", fontsize=9)
-        dbic = [c.bic - self.best.bic for c in self.candidates]
+        dbic = [c.bic - self.best_bic.bic for c in self.candidates]
         ax2.barh(range(len(dbic)), dbic)
         ax2.set_yticks(range(len(dbic)), [c.label for c in self.candidates], fontsize=7)
         ax2.invert_yaxis()
@@ -236,10 +265,12 @@ def band_rms_log(result: FitResult) -> dict[str, float]:
     return out
 
 
-def cross_validate(result: FitResult, options: FitOptions | Mapping[str, Any]) -> float:
+def cross_validate(result: FitResult, options: FitOptions | Mapping[str, Any], *,
+                   label: str | None = None) -> float:
     """Leave-one-incidence-out score of a fit made with ``options`` (a
     :class:`~roughbrdf.fitting.options.FitOptions` or its fields by name; module notes); NaN
-    with a single incidence."""
+    with a single incidence. A progress bar (``options.progress``) names the candidate
+    (``label``, default the fit's model), the fold's incidence and the channel."""
     if not isinstance(options, FitOptions):
         options = FitOptions.of(None, options, caller="cross_validate")
     meas = result.measurement
@@ -247,37 +278,53 @@ def cross_validate(result: FitResult, options: FitOptions | Mapping[str, Any]) -
     if angles.size < 2:
         return math.nan
     joint = bool(result.options.get("joint"))
-    loss = Loss.parse(result.loss)
     # one local fit on all training samples from the full optimum (no exploration stage: the
     # start is already in the basin)
     held: list[np.ndarray] = []
-    for g in angles:
-        out = np.abs(meas.theta_i - g) < 1e-6
-        train = meas.subset(~out)
-        # an array of weights, one per sample: the training samples'
-        weights = _subset_weights(options.weights, meas.n_samples, ~out)
-        groups = [result.channels] if joint else [[c] for c in result.channels]
-        for group in groups:
-            fold_options = options.replace(
-                channel=[c.channel for c in group], starts=1, progress=False, subsample=None,
-                joint=joint, shared=result.options["joint"]["shared"] if joint else None,
-                weights=weights)
-            fold = fit_model(group[0].model, train, fold_options, check_energy=False)
-            for c, fc in zip(group, fold.channels, strict=True):
-                idx = c.index[out[c.index]]
-                if idx.size == 0:
-                    continue
-                f = fold.predict(meas.theta_i[idx], meas.theta_r[idx], meas.phi[idx],
-                                 channel=c.channel,
-                                 polarization=None if meas.polarization is None
-                                 else meas.polarization[idx])
-                x = fc.scale * meas.values[idx, meas.channel_index(c.channel)]
-                with np.errstate(divide="ignore", invalid="ignore"):  # x <= 0: log loss
-                    # left-out samples of no log residual are not finite: filtered below
-                    held.append(loss.residual(x, np.asarray(f), floor=Loss.floor(x)))
+    groups = [result.channels] if joint else [[c] for c in result.channels]
+    with progress_bar(options.progress, angles.size * len(groups),
+                      f"cv {label or result.model_name}", unit="fold") as bar:
+        for g in angles:
+            out = np.abs(meas.theta_i - g) < 1e-6
+            held += _fold(result, options, meas.subset(~out), out, groups, bar,
+                          f"theta_i {math.degrees(g):g} deg")
     r = np.concatenate(held) if held else np.array([])
     r = r[np.isfinite(r)]
     return float(np.sqrt(np.mean(r * r))) if r.size else math.nan
+
+
+def _fold(result: FitResult, options: FitOptions, train: Measurement, out: np.ndarray,
+          groups: list[list[Any]], bar: Any, where: str) -> list[np.ndarray]:
+    """The left-out residuals of one incidence's fold (``out``: its samples), each channel
+    group refitted on ``train`` from the full fit's optimum."""
+    meas, loss = result.measurement, Loss.parse(result.loss)
+    joint = bool(result.options.get("joint"))
+    # an array of weights, one per sample: the training samples'
+    weights = _subset_weights(options.weights, meas.n_samples, ~out)
+    held: list[np.ndarray] = []
+    for group in groups:
+        if bar is not None:
+            bar.set_postfix_str(f"{where}, channel {'+'.join(str(c.channel) for c in group)}")
+        fold_options = options.replace(
+            channel=[c.channel for c in group], starts=1, progress=False, subsample=None,
+            joint=joint, shared=result.options["joint"]["shared"] if joint else None,
+            weights=weights)
+        fold = fit_model(group[0].model, train, fold_options, check_energy=False)
+        for c, fc in zip(group, fold.channels, strict=True):
+            idx = c.index[out[c.index]]
+            if idx.size == 0:
+                continue
+            f = fold.predict(meas.theta_i[idx], meas.theta_r[idx], meas.phi[idx],
+                             channel=c.channel,
+                             polarization=None if meas.polarization is None
+                             else meas.polarization[idx])
+            x = fc.scale * meas.values[idx, meas.channel_index(c.channel)]
+            with np.errstate(divide="ignore", invalid="ignore"):  # x <= 0: log loss
+                # left-out samples of no log residual are not finite: filtered below
+                held.append(loss.residual(x, np.asarray(f), floor=Loss.floor(x)))
+        if bar is not None:
+            bar.update(1)
+    return held
 
 
 def _subset_weights(weights: Any, n: int, keep: np.ndarray) -> Any:
@@ -336,7 +383,8 @@ def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | 
     Returns
     -------
     ModelComparison
-        Candidates sorted by BIC, best first.
+        Candidates best first (:func:`rank`: by the cross-validation score, or BIC without
+        one).
 
     Examples
     --------
@@ -360,8 +408,8 @@ def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | 
             spec_text(m), res, k, n, aic, bic,
             float(np.median([c.sigma for c in res.channels])),
             float(np.median([c.rms_log for c in res.channels])), band_rms_log(res),
-            cross_validate(res, options) if cv else None, res.elapsed))
-    rows.sort(key=lambda c: c.bic)
+            cross_validate(res, options, label=spec_text(m)) if cv else None, res.elapsed))
+    rows, criterion = rank(rows)
     notes = ["BIC and AIC assume independent residuals; neighbouring samples share the "
              "models' systematic misfit, so differences of this size overstate the evidence. "
              "CV: r.m.s. loss residual of each incidence predicted by a fit without it "
@@ -369,20 +417,50 @@ def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | 
     if len({c.n_points for c in rows}) > 1:
         notes.append("the candidates were fitted on different numbers of samples (the "
                      "model's own domain differs): their AIC/BIC are not comparable")
-    best_cv = ModelComparison(rows, measurement).best_cv
-    if best_cv is not None and best_cv is not rows[0]:
-        notes.append(f"cross-validation prefers {best_cv.label} (BIC: {rows[0].label})")
+    notes += choice_notes(ModelComparison(rows, measurement, criterion=criterion))
     notes.append("max albedo: the fitted model's largest directional-hemispherical reflectance "
                  "(0-85 deg; > 1 gains energy); peak ratio: model/data maximum of the "
                  "incidence where it is farthest from 1; search limit: parameters that ended "
                  "on a search bound that is no physical limit (not a result)")
-    return ModelComparison(rows, measurement, notes)
+    return ModelComparison(rows, measurement, notes, criterion)
+
+
+def rank(rows: Sequence[Candidate]) -> tuple[list[Candidate], str]:
+    """The candidates best first and the criterion (module notes): ``"cv"`` when every
+    candidate has a finite cross-validation score, else ``"bic"``; those that gain energy
+    last. Ties keep the given order."""
+    cv = all(c.cv is not None and math.isfinite(c.cv) for c in rows)
+    criterion = "cv" if cv else "bic"
+
+    def key(c: Candidate) -> tuple[bool, float]:
+        return c.gains_energy, float(c.cv) if cv else c.bic  # type: ignore[arg-type]
+
+    return sorted(rows, key=key), criterion
+
+
+def choice_notes(cmp: ModelComparison) -> list[str]:
+    """What the ranking chose against what BIC or the score alone would have."""
+    notes = []
+    best, by_bic = cmp.best, cmp.best_bic
+    if cmp.criterion == "cv":
+        if by_bic is not best:
+            notes.append(f"ranked by cross-validation: {best.label} predicts the left-out "
+                         f"incidences best; BIC prefers {by_bic.label} (they disagree)")
+    else:
+        by_cv = cmp.best_cv
+        if by_cv is not None and by_cv is not best:
+            notes.append(f"cross-validation prefers {by_cv.label} (ranked by BIC: {best.label})")
+    if any(c.gains_energy for c in cmp.candidates):
+        notes.append("candidates whose fitted model gains energy rank last, whatever their "
+                     "score")
+    return notes
 
 
 def fit_auto(measurement: Measurement, candidates: Sequence[Model | str] | str | None = None,
              *, cv: bool = True, options: FitOptions | None = None,
              **keywords: Any) -> FitResult:
-    """``rb.fit("auto", ...)``: :func:`compare` the candidates and return the best fit by BIC,
+    """``rb.fit("auto", ...)``: :func:`compare` the candidates and return the best (by the
+    cross-validation score, BIC without one; :func:`rank`),
     with the comparison attached (``FitResult.model_choice``: in ``fit.json``, the report and
     ``compare.png``). ``options`` and ``keywords`` as for :func:`compare`; ``fix`` and
     ``bounds`` are refused (ArgumentError)."""

@@ -34,7 +34,8 @@ def fit(model: Model | str, measurement: Measurement, *, options: FitOptions | N
     model : Model or str
         Model with starting values (``rb.model(...)``; sums allowed), a registered name or
         spec (``"coated(lobes=2)"``), or ``"auto"``: fit the candidates of
-        :data:`~roughbrdf.fitting.compare.AUTO_CANDIDATES` and keep the lowest BIC, with
+        :data:`~roughbrdf.fitting.compare.AUTO_CANDIDATES` and keep the best by
+        cross-validation (BIC beside it), with
         every candidate's figures and a leave-one-incidence-out score in ``model_choice``
         (:func:`~roughbrdf.fitting.compare.fit_auto`; ``fix`` and ``bounds`` do not apply).
     measurement : Measurement

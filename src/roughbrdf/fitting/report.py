@@ -68,8 +68,10 @@ def report(result: FitResult, *, min_correl: float = 0.1, angles: str = "rad") -
         # a Mueller fit's channel adds its normalized elements (fitting.polarimetric)
         lines += getattr(c, "report_lines", list)()
     if result.model_choice is not None:
-        lines += ["", "[[Model choice]] candidates sorted by BIC (best first; chosen: "
-                  f"{result.model_choice.best.label})", result.model_choice.table()]
+        choice = result.model_choice
+        by = "cross-validation score" if choice.criterion == "cv" else "BIC"
+        lines += ["", f"[[Model choice]] candidates sorted by {by} (best first; chosen: "
+                  f"{choice.best.label})", choice.table()]
     return "\n".join(lines)
 
 

@@ -307,8 +307,10 @@ class MultiStart:
 
 
 @contextmanager
-def progress_bar(show: bool | None, total: int, desc: str) -> Iterator[Any]:
-    """A tqdm bar (``show=None``: only on an interactive terminal), or None."""
+def progress_bar(show: bool | None, total: int, desc: str, unit: str = "start"
+                 ) -> Iterator[Any]:
+    """A tqdm bar counting ``total`` ``unit`` (``show=None``: only on an interactive terminal),
+    or None."""
     if show is None:
         show = bool(getattr(sys.stderr, "isatty", lambda: False)())
     if not show:
@@ -316,7 +318,7 @@ def progress_bar(show: bool | None, total: int, desc: str) -> Iterator[Any]:
         return
     from tqdm.auto import tqdm
 
-    bar = tqdm(total=total, desc=desc, unit="start", leave=False)
+    bar = tqdm(total=total, desc=desc, unit=unit, leave=False)
     try:
         yield bar
     finally:

@@ -13,7 +13,8 @@ from .base import MODELS, Model, SumModel
 __all__ = ["AUTO", "as_model", "available", "from_spec", "is_auto", "model", "model_label",
            "resolve_names", "spec_text", "split_specs"]
 
-#: the pseudo-model of ``rb.fit("auto", ...)``: the candidates of model choice, best by BIC
+#: the pseudo-model of ``rb.fit("auto", ...)``: the candidates of model choice, best by
+#: cross-validation
 AUTO = "auto"
 
 

@@ -110,7 +110,8 @@ def test_ctrl_c_at_start_is_one_line_exit_130(data, tmp_path):
 
 @pytest.mark.parametrize(("options", "message"), [
     (["--starts", "0"], "error: --starts must be >= 1 (got 0)"),
-    (["--loss", "x"], "error: --loss: unknown value 'x' (choose from relative, log, absolute)"),
+    (["--loss", "x"], "error: --loss: unknown value 'x' (choose from relative, log, absolute, "
+                     "robust)"),
     (["--seed", "-1"], "error: --seed must be >= 0 (got -1)"),
     (["--format", "zz"], "error: --format: unknown value 'zz' (choose from astm, alta, merl, "
                          "csv, zemax)"),

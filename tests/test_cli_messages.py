@@ -194,7 +194,7 @@ def test_loss_names_option_and_choices(capsys, tmp_path, verb):
                      tmp_path / "o")
     line = _one_line(err)
     assert code == 2 and "--loss" in line and "'squared'" in line
-    assert "relative, log, absolute" in line
+    assert "relative, log, absolute, robust" in line
 
 
 # --------------------------------------------------------------------------------------------

@@ -52,7 +52,8 @@ BoundsOption = Annotated[list[str] | None, typer.Option(
          "such as sigma in degrees; a default starting value outside it starts in the middle)")]
 ChannelOption = Annotated[list[str] | None, typer.Option(
     "--channel", "-c", help="channel label or index (repeatable; default: all)")]
-LossOption = Annotated[str, typer.Option(help="relative ((x-f)/f, TR75), log or absolute")]
+LossOption = Annotated[str, typer.Option(
+    help="relative ((x-f)/f, TR75), log, absolute or robust (soft-L1 of ln x - ln f)")]
 StartsOption = Annotated[int, typer.Option(help="multistart points per channel")]
 QuantityOption = Annotated[str | None, typer.Option(
     help="input: what the file's values are, if the file does not say: brdf, brdf_cos "

@@ -5,7 +5,11 @@ What :func:`roughbrdf.fit` runs for a model that is not ``"auto"``, and what mod
 (:mod:`~roughbrdf.fitting.compare`) runs for each candidate: :func:`fit_model`. Each channel is
 fitted on its own by default; ``scipy.optimize.least_squares`` (trust-region reflective, box
 bounds) minimizes the sum of squared residuals, one per sample: ``(K x - f)/f`` by default,
-whose r.m.s. is TR75's sigma (Eq. 34).
+whose r.m.s. is TR75's sigma (Eq. 34). With ``options.energy_constraint`` (the default), a
+channel whose fitted model reflects more than it receives on the grid 0, 5, ... 85, 89 deg is
+refitted from that optimum under ``albedo <= 1`` (:mod:`~roughbrdf.fitting.energy`); joint fits
+and Mueller fits are checked and warned about, not constrained (``docs/fitting.md``, "Energy
+constraint").
 """
 
 from __future__ import annotations
@@ -16,10 +20,11 @@ from typing import TYPE_CHECKING, Any
 from ..errors import ArgumentError
 from ..models.factory import as_model, model_label
 from .data import ChannelData, prepare_channel
+from .energy import EnergyConstraint, conditional_covariance, constrain_channel
 from .joint import fit_joint
 from .objective import ObjectiveSpec
 from .plan import FitPlan, channel_indices, check_enough_data
-from .plausibility import warn_energy
+from .plausibility import EXPORT_INCIDENCES_DEG, warn_energy
 from .polarimetric import fit_mueller
 from .result import ChannelFit, FitResult
 from .search import MultiStart, SearchOptions, progress_bar
@@ -82,14 +87,17 @@ def fit_channels(model: Model, measurement: Measurement, options: FitOptions) ->
         if joint:
             results, summary = fit_joint(spec, data, search, options.shared, tick)
         else:
-            results, summary = _separately(spec, search, data, bar, tick), None
+            results, summary = _separately(spec, search, data, bar, tick,
+                                           options.energy_constraint), None
     return FitResult(channels=results, **plan.result_fields(
-        measurement, time.perf_counter() - t_start, joint=summary))
+        measurement, time.perf_counter() - t_start, joint=summary,
+        energy_constraint=options.energy_constraint and not joint))
 
 
 def _separately(spec: ObjectiveSpec, search: SearchOptions, data: list[ChannelData],
-                bar: Any, tick: Any) -> list[ChannelFit]:
-    """Each channel on its own, in order (the previous optimum is a warm start)."""
+                bar: Any, tick: Any, energy: bool = True) -> list[ChannelFit]:
+    """Each channel on its own, in order (the previous optimum is a warm start); with
+    ``energy``, a channel whose model gains energy refitted under the constraint."""
     results: list[ChannelFit] = []
     runner = MultiStart(spec, search, tick)
     for d in data:
@@ -97,5 +105,20 @@ def _separately(spec: ObjectiveSpec, search: SearchOptions, data: list[ChannelDa
         if bar is not None:
             bar.set_postfix_str(d.label)
         obj, outcome = runner.run(d)
-        results.append(ChannelFit.from_search(obj, outcome, time.perf_counter() - t0))
+        info = None
+        if energy:
+            outcome, info = constrain_channel(spec, d, outcome, search.max_nfev)
+            runner.warm = outcome.theta.copy()  # the next channel starts from the result
+        fit = ChannelFit.from_search(obj, outcome, time.perf_counter() - t0)
+        results.append(fit if info is None else _constrained(fit, obj, info))
     return results
+
+
+def _constrained(fit: ChannelFit, obj: Any, info: EnergyConstraint) -> ChannelFit:
+    """``fit`` at a constrained optimum: its covariance conditional on the active
+    constraints, the message saying so, and ``info`` kept (``fit.json``)."""
+    active = [EXPORT_INCIDENCES_DEG.index(t) for t in info.theta_deg]
+    out = conditional_covariance(fit, obj, active) if info.satisfied else fit
+    out.message += info.note()
+    out.energy_constraint = info
+    return out

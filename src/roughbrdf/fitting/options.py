@@ -127,6 +127,12 @@ class FitOptions:
         the ``loss`` residuals of ``m00`` (default 1).
     progress : bool or None
         Show a tqdm progress bar; ``None`` shows it only on an interactive terminal.
+    energy_constraint : bool
+        Refit a channel whose fitted model reflects more than it receives (albedo above
+        ``1 + 1e-3`` at some incidence of 0, 5, ... 85, 89 deg) under the constraint
+        ``albedo <= 1`` there (:mod:`~roughbrdf.fitting.energy`); models that conserve energy
+        by construction never need it. ``False``: the unconstrained fit (as the papers').
+        Joint and Mueller fits are checked, not constrained.
 
     Raises
     ------
@@ -134,7 +140,7 @@ class FitOptions:
         On construction (and by :meth:`replace`), for every option that is bad whatever the
         model and the data: the aperture and its rule, the fit domain, the loss, ``nonfinite``,
         ``negative``, ``extrapolated``, the search counts and seed, ``scale``, ``joint``,
-        ``shared`` without a joint fit, ``polarimetric_weight``.
+        ``shared`` without a joint fit, ``polarimetric_weight``, ``energy_constraint``.
     """
 
     channel: int | str | Sequence[int | str] | None = None
@@ -162,6 +168,7 @@ class FitOptions:
     shared: Iterable[str] | None = None
     polarimetric_weight: float | None = None
     progress: bool | None = None
+    energy_constraint: bool = True
 
     def __post_init__(self) -> None:
         # in the order the fit met them before the options were one object
@@ -180,6 +187,9 @@ class FitOptions:
                                 "joint=True (command line: --joint)", value=named)
         if self.polarimetric_weight is not None:
             check_polarimetric_weight(self.polarimetric_weight)
+        if not isinstance(self.energy_constraint, bool):  # a string "no" would be truthy
+            raise ArgumentError("energy_constraint", "must be True or False",
+                                value=self.energy_constraint)
 
     @classmethod
     def of(cls, options: FitOptions | None = None, keywords: Mapping[str, Any] | None = None,

@@ -137,6 +137,8 @@ class ChannelFit:
     at_bound: dict[str, str] = field(default_factory=dict)
     #: the :class:`~roughbrdf.fitting.plausibility.Plausibility` (:meth:`FitResult.plausibility`)
     plausibility: Plausibility | None = field(default=None, repr=False)
+    #: what the energy constraint did (:class:`~roughbrdf.fitting.energy.EnergyConstraint`)
+    energy_constraint: Any = field(default=None, repr=False)
 
     @property
     def limits(self) -> dict[str, str]:
@@ -204,7 +206,8 @@ class ChannelFit:
                 "bounds": {k: list(v) for k, v in self.bounds.items()}, "scale": self.scale,
                 "scale_stderr": self.scale_stderr, "correl": self.correl,
                 "excluded": self.excluded, "nfev": self.nfev, "elapsed_s": self.elapsed,
-                "model_spec": self.model.to_dict()}
+                "model_spec": self.model.to_dict(), "energy_constraint": None
+                if self.energy_constraint is None else self.energy_constraint.to_dict()}
 
 
 @dataclass

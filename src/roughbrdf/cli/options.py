@@ -85,6 +85,11 @@ SourceExclusionOption = Annotated[float | None, typer.Option(
     help="fit domain: leave out samples within DEG of the direction toward the source "
          "(retro-blocked; counted; default: none)")]
 PlotsOption = Annotated[bool, typer.Option("--plots/--no-plots", help="write PNG plots")]
+EnergyConstraintOption = Annotated[bool, typer.Option(
+    "--energy-constraint/--no-energy-constraint",
+    help="refit a model that reflects more than it receives (albedo > 1 at some theta_i of "
+         "0, 5, ... 85, 89 deg) under albedo <= 1 there; --no-energy-constraint: the "
+         "unconstrained fit")]
 
 #: every shared option: parameter name -> (typer annotation, default)
 TABLE: dict[str, tuple[Any, Any]] = {
@@ -98,18 +103,24 @@ TABLE: dict[str, tuple[Any, Any]] = {
     "negative": (NegativeOption, "keep"), "seed": (SeedOption, 0),
     "free_scale": (FreeScaleOption, None), "aperture": (ApertureOption, None),
     "theta_r_max": (ThetaRMaxOption, None), "source_exclusion": (SourceExclusionOption, None),
-    "plots": (PlotsOption, True),
+    "plots": (PlotsOption, True), "energy_constraint": (EnergyConstraintOption, True),
 }
 #: the CLI values that are FitOptions fields as they are
 _AS_GIVEN = ("loss", "starts", "seed", "nonfinite", "negative", "relative_to", "free_scale",
-             "joint")
+             "joint", "energy_constraint")
+#: options every verb that fits takes (those whose ``order`` has ``starts``), placed after it
+_FITTING = ("energy_constraint",)
 
 
 def command(func: Callable[..., Any], order: list[str],
             own: Mapping[str, tuple[Any, Any]]) -> Callable[..., Any]:
     """``func`` (a verb taking ``**values``) with the signature typer reads: the parameters
     ``order`` in that order, each from ``own`` (the verb's own, ``(annotation, default)``;
-    default ``inspect.Parameter.empty``: required) or else from :data:`TABLE`."""
+    default ``inspect.Parameter.empty``: required) or else from :data:`TABLE`. A verb that
+    fits (``starts`` in ``order``) also gets the :data:`_FITTING` options after ``starts``."""
+    if "starts" in order:  # declared here once, not in each verb's list
+        at = order.index("starts") + 1
+        order = order[:at] + [n for n in _FITTING if n not in order] + order[at:]
     params = [inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY,
                                 annotation=spec[0], default=spec[1])
               for name in order for spec in [own.get(name) or TABLE[name]]]

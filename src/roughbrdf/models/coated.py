@@ -35,6 +35,7 @@ lobe, ``shadowing="smith-separable"``, ``shadow_diffuse=False``, ``interface="ro
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numba import prange
@@ -44,11 +45,15 @@ from .. import shadowing as shd
 from .._kernels import at, driver, jit, sincos
 from ..diffuse import (
     ROUGH_TABLE_SIZE,
+    TABLE_NODES,
     coated_diffuse,
     coated_diffuse_rough,
+    lobe_albedo,
     oren_nayar_factor,
     rough_interface,
+    table_lerp,
 )
+from ..errors import ArgumentError
 from ..fresnel import diffuse_reflectance, fresnel_polarized_xy, fresnel_sp
 from ..geometry import half_vector, tr75_eta_xy
 from ..mueller import facet_mueller
@@ -59,11 +64,14 @@ from .parameters import Parameter, nonnegative, positive, reflectance
 DIFFUSE = {"lambertian": 0, "oren-nayar": 1}
 #: ``interface`` option -> code in the packed parameters
 INTERFACE = {"smooth": 0, "rough": 1}
+#: ``weights`` option: the lobes' weights sum to 1 (default), or free scales (legacy)
+WEIGHTS = ("partition", "free")
 #: most specular lobes (the packed parameters have a slot for each; an unused lobe has ks = 0)
 MAX_LOBES = 3
 _LOBE0 = 7  # index of the first lobe's (alpha, ks, norm) in the packed parameters
 # packed after the distribution code (16): the interface code (17), the rough interface's
-# internal reflectance (18) and its transmittance table (19 to 82; zeros for "smooth")
+# internal reflectance (18) and its transmittance table (19 to 82; for "smooth" the factor
+# table of _smooth_factors)
 _INTERFACE = 17
 _TABLE0 = 19
 
@@ -91,7 +99,10 @@ def _coated_terms(ti, tr, phi, gamma, p, dcode, rough):
     if rough:  # a literal in each driver loop: the other interface's code compiles away
         diff = coated_diffuse_rough(ci, cr, n, rho, p[18], p, _TABLE0)
     else:
-        diff = coated_diffuse(ci, cr, n, gamma, rho, fdr_int)
+        # the smooth interface's factor table (1 where the lobes reflect at most R(theta);
+        # _smooth_factors): what the lobes do not reflect is all the substrate can receive
+        diff = coated_diffuse(ci, cr, n, gamma, rho, fdr_int) * table_lerp(
+            ci, p, _TABLE0) * table_lerp(cr, p, _TABLE0)
     if dmode > 0.0:
         sr, cp = sincos(tr)[0], sincos(phi)[1]
         diff *= oren_nayar_factor(ci, cr, si, sr, cp, sigma2)
@@ -172,13 +183,67 @@ def _coated_mueller_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compi
             _substrate_mueller(out, i, diff, ci, cr, p[0])
 
 
-def _lobe_parameters(j: int) -> tuple[Parameter, Parameter]:
+def _lobe_parameters(j: int, free: bool) -> tuple[Parameter, ...]:
+    """Lobe ``j``'s width and, with ``free``, its free scale ``ks_j`` (legacy), else (``j >= 2``)
+    its share ``w_j`` of the weight (:func:`lobe_weights`)."""
     suffix = "" if j == 1 else str(j)
-    alpha = (0.05, 0.3, 0.6)[j - 1]
-    return (positive("alpha" + suffix, alpha, (0.005, 1.5), "1",
-                     f"width of specular lobe {j} (distribution parameter)"),
-            nonnegative("ks" + suffix, 1.0 if j == 1 else 0.2, (0.0, 20.0), "1",
-                        f"scale of specular lobe {j} (1: the interface alone)"))
+    alpha = positive("alpha" + suffix, (0.05, 0.3, 0.6)[j - 1], (0.005, 1.5), "1",
+                     f"width of specular lobe {j} (distribution parameter)")
+    if free:
+        return (alpha, nonnegative("ks" + suffix, 1.0 if j == 1 else 0.2, (0.0, 20.0), "1",
+                                   f"free scale of specular lobe {j} (weights='free'; 1: the "
+                                   f"interface alone; not energy-conserving)"))
+    if j == 1:
+        return (alpha,)  # its weight is what the other lobes leave
+    share = ("lobe 2's share of the lobes' weight" if j == 2 else
+             "lobe 3's share of the weight lobe 2 leaves")
+    return (alpha, Parameter(f"w{j}", 0.2, (0.0, 1.0), "1", share + " (weights sum to 1)",
+                             (0.0, True, 1.0, True)))
+
+
+def lobe_weights(lobes: int, w2: float = 0.0, w3: float = 0.0) -> tuple[float, ...]:
+    """The lobes' weights from the stick-breaking shares: they sum to 1 for every ``w2``,
+    ``w3`` in [0, 1].
+
+    One lobe: ``(1,)``; two: ``(1 - w2, w2)``; three: ``((1 - w2)(1 - w3), w2, (1 - w2) w3)``.
+
+    Examples
+    --------
+    >>> lobe_weights(3, 0.2, 0.25)
+    (0.6000000000000001, 0.2, 0.2)
+    """
+    if lobes == 1:
+        return (1.0,)
+    if lobes == 2:
+        return (1.0 - w2, w2)
+    return ((1.0 - w2) * (1.0 - w3), w2, (1.0 - w2) * w3)
+
+
+def _smooth_factors(lobes: list[tuple[float, float]], n: float, distribution: str,
+                    shadowing: str) -> np.ndarray:
+    """The smooth interface's transmission factor ``s(mu) = min(1, (1 - E(mu))/(1 - R(mu)))``
+    at :data:`~roughbrdf.diffuse.TABLE_NODES`, ``E = sum_j w_j E_j`` the lobes' albedo
+    (:func:`~roughbrdf.diffuse.lobe_albedo`), ``R`` the smooth interface's reflectance.
+
+    A rough lobe reflects the facet-averaged ``F(theta_d)``, which can exceed ``R(theta)``
+    (by up to 0.3 %: Beckmann, ``alpha`` about 0.2); the substrate then receives at most what
+    the lobes leave, ``1 - E``. 1 wherever ``E <= R``: those values are the smooth formula's.
+    """
+    mu = TABLE_NODES
+    e = np.zeros(ROUGH_TABLE_SIZE)
+    for w, a in lobes:
+        if w > 0.0:  # a lobe of weight 0 reflects nothing (and costs no table)
+            e += w * lobe_albedo(a, n, distribution, shadowing)
+    c = mu
+    g = np.sqrt(n * n - 1.0 + c * c)
+    rs = ((g - c) / (g + c)) ** 2
+    rp = rs * ((c * (g + c) - 1.0) / (c * (g - c) + 1.0)) ** 2
+    t = 1.0 - 0.5 * (rs + rp)
+    s = np.minimum(1.0, (1.0 - e) / t)
+    # the first node (cos = 1e-6) has t ~ 1e-6: its ratio is rounding; the substrate is 0
+    # there anyway, so it takes the next node's factor
+    s[0] = s[1]
+    return np.maximum(s, 0.0)
 
 
 @register
@@ -187,11 +252,16 @@ class Coated(Model):
 
     Options: ``distribution`` (``"trowbridge-reitz"``/GGX or ``"beckmann"``), ``shadowing``
     (``"smith-separable"`` or ``"smith-height-correlated"``), ``lobes`` (1 to 3 specular lobes
-    sharing ``n``), ``diffuse`` (``"lambertian"`` or ``"oren-nayar"``), ``shadow_diffuse``
-    (mask and shadow the substrate term by the first lobe's Smith G), ``interface``
-    (``"smooth"``: Fresnel transmission of a smooth interface into and out of the coating;
-    ``"rough"``: the first lobe's rough-interface transmittance, Mitsuba 3's ``roughplastic``;
-    listed in :attr:`options` only when ``"rough"``). Reciprocal. ``docs/models.md`` §10.3; the
+    of one interface, sharing ``n``), ``diffuse`` (``"lambertian"`` or ``"oren-nayar"``),
+    ``shadow_diffuse`` (mask and shadow the substrate term by the first lobe's Smith G),
+    ``interface`` (``"smooth"``: Fresnel transmission of a smooth interface into and out of
+    the coating, limited to what the lobes leave; ``"rough"``: the lobes' rough-interface
+    transmittance, Mitsuba 3's ``roughplastic``; listed in :attr:`options` only when
+    ``"rough"``), ``weights`` (``"partition"``, default: the lobes' weights sum to 1 --
+    one lobe has weight 1, ``w2`` and ``w3`` share it out (:func:`lobe_weights`) -- so no
+    parameter value reflects more than it receives; ``"free"``: the free scales ``ks``,
+    ``ks2``, ``ks3`` in [0, 20] of roughbrdf 0.1.0, *not energy-conserving*, for fits
+    saved by it; listed only when ``"free"``). Reciprocal. ``docs/models.md`` §10.3; the
     module notes give the formula.
 
     Examples
@@ -199,13 +269,17 @@ class Coated(Model):
     >>> import roughbrdf as rb
     >>> m = rb.model("coated", n=1.5, alpha=0.1, rho=0.6, lobes=2)
     >>> m.param_names
-    ['n', 'rho', 'alpha', 'ks', 'alpha2', 'ks2']
-    >>> m0 = m.with_params(rho=1.0, ks=0.0, ks2=0.0, shadow_diffuse=False)
-    >>> round(float(rb.albedo(m0, 0.0)), 3)      # rho = 1, no lobes: 1 - F(0), F(0) = 0.04
-    0.96
+    ['n', 'rho', 'alpha', 'alpha2', 'w2']
+    >>> m0 = m.with_params(rho=1.0, lobes=1, alpha=0.005, shadow_diffuse=False)
+    >>> round(float(rb.albedo(m0, 0.0)), 3)      # rho = 1: all light comes back out
+    1.0
     >>> rough = rb.model("coated", alpha=0.3, rho=0.5, shadow_diffuse=False, interface="rough")
     >>> round(rough.brdf(0.0, 0.0, 0.0), 5)     # roughplastic's value (Mitsuba 3)
     0.11645
+    >>> rb.model("coated", ks=0.5)
+    Traceback (most recent call last):
+    ...
+    roughbrdf.errors.ArgumentError: ks = 0.5: the coated model has no parameter 'ks' ...
     """
 
     name = "coated"
@@ -213,8 +287,22 @@ class Coated(Model):
     short = "coat"
     reference = "Weidlich & Wilkie 2007; Walter et al. 2007; Oren & Nayar 1994"
     OPTIONS = {"distribution": "trowbridge-reitz", "shadowing": "smith-separable", "lobes": 1,
-               "diffuse": "lambertian", "shadow_diffuse": True, "interface": "smooth"}
+               "diffuse": "lambertian", "shadow_diffuse": True, "interface": "smooth",
+               "weights": "partition"}
     _drive = _coated_drive
+
+    def __init__(self, **kwargs: Any) -> None:
+        # the free lobe scales are gone unless asked for: a clear error, not "unknown name"
+        if str(kwargs.get("weights", "partition")).strip().lower() != "free":
+            old = [k for k in ("ks", "ks2", "ks3") if k in kwargs]
+            if old:
+                raise ArgumentError(
+                    old[0], f"the coated model has no parameter {old[0]!r} any more: its "
+                    f"lobes are one interface and their weights sum to 1 (one lobe: weight 1; "
+                    f"lobes=2, 3: shares w2, w3 in [0, 1]), so that it cannot reflect more than "
+                    f"it receives; weights='free' restores the old free scales ks, ks2, ks3 "
+                    f"(not energy-conserving)", value=kwargs[old[0]])
+        super().__init__(**kwargs)
 
     def _check_options(self, options):
         d = dist.get(options["distribution"])
@@ -243,20 +331,26 @@ class Coated(Model):
         if interface not in INTERFACE:
             raise ValueError(f"interface must be 'smooth' or 'rough', "
                              f"got {options['interface']!r}")
+        weights = str(options["weights"]).strip().lower()
+        if weights not in WEIGHTS:
+            raise ValueError(f"weights must be 'partition' or 'free', got {options['weights']!r}")
         out = {"distribution": d.name, "shadowing": shd.canonical(s), "lobes": int(lobes),
                "diffuse": diffuse, "shadow_diffuse": sd}
+        # interface and weights are listed only when not the default: models, reprs and fit
+        # files of the default coating read as they did before the options existed
         if interface == "rough":
-            # listed only when not the default: models, reprs and fit files of the smooth
-            # coating read as they did before the option existed
             out["interface"] = interface
+        if weights == "free":
+            out["weights"] = weights
         return out
 
     def _parameter_specs(self) -> tuple[Parameter, ...]:
         specs = [Parameter("n", 1.5, (1.05, 2.5), "1", "refractive index of the coating",
                            (1.0, False, math.inf, False)),
                  reflectance("rho", 0.5, "albedo of the diffuse substrate")]
+        free = self._options.get("weights") == "free"
         for j in range(1, self._options["lobes"] + 1):
-            specs.extend(_lobe_parameters(j))
+            specs.extend(_lobe_parameters(j, free))
         if self._options["diffuse"] == "oren-nayar":
             specs.append(nonnegative("sigma", 0.3, (0.0, 1.2), "rad",
                                      "Oren-Nayar slope-angle deviation of the substrate"))
@@ -268,26 +362,60 @@ class Coated(Model):
             name = "alpha" if j == 1 else f"alpha{j}"
             dist.check_param(code, self._floats()[name], name)
 
+    def specular_lobes(self) -> list[tuple[float, float]]:
+        """``[(weight, alpha), ...]`` of the specular lobes: the weights of
+        :func:`lobe_weights` (they sum to 1), or the free scales ``ks_j`` with
+        ``weights="free"``.
+
+        Examples
+        --------
+        >>> import roughbrdf as rb
+        >>> rb.model("coated", lobes=2, alpha=0.05, alpha2=0.3, w2=0.25).specular_lobes()
+        [(0.75, 0.05), (0.25, 0.3)]
+        """
+        v, o = self._floats(), self._options
+        alphas = [v["alpha" if j == 1 else f"alpha{j}"] for j in range(1, o["lobes"] + 1)]
+        if o.get("weights") == "free":
+            ws: tuple[float, ...] = tuple(v["ks" if j == 1 else f"ks{j}"]
+                                          for j in range(1, o["lobes"] + 1))
+        else:
+            ws = lobe_weights(o["lobes"], v.get("w2", 0.0), v.get("w3", 0.0))
+        return list(zip(ws, alphas, strict=True))
+
+    def _interface(self, lobes: list[tuple[float, float]]) -> tuple[float, ...]:
+        """The packed interface code, internal reflectance and table (module notes)."""
+        v, o = self._floats(), self._options
+        if o.get("interface") == "rough":
+            if o.get("weights") == "free":  # legacy: the first lobe's interface
+                table, f_int = rough_interface(v["alpha"], v["n"], o["distribution"])
+                return (1.0, f_int, *table)
+            # the interface is the lobes' mixture: its transmittance and internal
+            # reflectance are the weight-mixtures of each lobe's (linear in the distribution)
+            mix, f_mix = np.zeros(ROUGH_TABLE_SIZE), 0.0
+            for w, a in lobes:
+                if w > 0.0:  # a lobe of weight 0 is no part of the interface (no table)
+                    table, f_int = rough_interface(a, v["n"], o["distribution"])
+                    mix += w * table
+                    f_mix += w * f_int
+            return (1.0, f_mix, *mix)
+        if o.get("weights") == "free":  # legacy: the smooth factors unlimited
+            return (0.0, 0.0) + (1.0,) * ROUGH_TABLE_SIZE
+        factors = _smooth_factors(lobes, v["n"], o["distribution"], o["shadowing"])
+        return (0.0, 0.0, *factors)
+
     def _pack(self) -> tuple:
         v, o = self._floats(), self._options
         d = dist.get(o["distribution"]).code
-        lobes: list[float] = []
-        for j in range(1, MAX_LOBES + 1):
-            if j <= o["lobes"]:
-                a = v["alpha" if j == 1 else f"alpha{j}"]
-                ks = v["ks" if j == 1 else f"ks{j}"]
-            else:
-                a, ks = 1.0, 0.0  # unused slot: a valid width, switched off by ks = 0
-            lobes += [a, ks, dist.normalization(d, a)]
-        if o.get("interface") == "rough":
-            table, f_int = rough_interface(v["alpha"], v["n"], o["distribution"])
-            rough = (1.0, f_int, *table)
-        else:
-            rough = (0.0, 0.0) + (0.0,) * ROUGH_TABLE_SIZE
+        used = self.specular_lobes()
+        packed: list[float] = []
+        for j in range(MAX_LOBES):
+            # unused slot: a valid width, switched off by weight 0
+            w, a = used[j] if j < len(used) else (0.0, 1.0)
+            packed += [a, w, dist.normalization(d, a)]
         return (v["n"], v["rho"], v.get("sigma", 0.0) ** 2,
                 shd.get(o["shadowing"]).code, DIFFUSE[o["diffuse"]],
                 1.0 if o["shadow_diffuse"] else 0.0,
-                diffuse_reflectance(v["n"], internal=True), *lobes, d, *rough)
+                diffuse_reflectance(v["n"], internal=True), *packed, d, *self._interface(used))
 
     def _mueller(self, g: PreparedGeometry, basis: int, term: str | None) -> np.ndarray:
         return self._mueller_drive(_coated_mueller_drive, g, self._pack(), basis, term)

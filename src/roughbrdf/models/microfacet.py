@@ -6,8 +6,15 @@ Cook & Torrance (1982) / Walter et al. (2007) form, built from :mod:`roughbrdf.d
     f_r = ks F(theta_d) D(theta_h) G / (4 cos theta_i cos theta_r)
 
 ``F`` at the local angle ``theta_d`` (polarization per TR75 Eq. 24); ``n=None`` gives ``F = 1``.
-``ks`` is an overall scale (1 for a physical surface; free for fits to data of unknown scale):
-not a reflectance of a part, so it is not limited to [0, 1] (``roughbrdf.models.parameters``).
+``ks`` is an overall scale, 1 for a physical surface. Its domain is ``[0, inf)`` (it is not a
+reflectance of a part, ``roughbrdf.models.parameters``), but its search range is the physical
+``[0, 1]``: one interface with ``F <= 1`` reflects at most what it receives (the albedo at
+``ks = 1`` is at most 1 + 1e-4 for every distribution and shadowing, ``alpha`` 0.01-2,
+``tests/test_coated_energy.py``). A fit may be given a wider range (``bounds={"ks": (0, 20)}``);
+its report and ``fit.json`` then say it used a non-physical range
+(:mod:`roughbrdf.fitting.physical`). With data of unknown scale (a free data scale ``K``) a
+lone microfacet lobe's ``ks`` and ``K`` are one degree of freedom: ``ks`` is held at its value
+(``docs/fitting.md``).
 The parameter ``alpha`` is the width parameter of the chosen distribution: ``e`` for
 Trowbridge-Reitz/GGX and Berry, ``m`` for Beckmann, ``c`` (per degree) for gaussian-angle, ``A2``
 for Sirohi.
@@ -126,7 +133,8 @@ class Microfacet(Model):
                   (0.0, False, math.inf, False), optional=True),
         Parameter("k", 0.0, (0.0, 10.0), "1", "extinction index (n + ik)",
                   (0.0, True, math.inf, False), optional=True),
-        nonnegative("ks", 1.0, (0.0, 20.0), "1", "scale of the specular term"),
+        nonnegative("ks", 1.0, (0.0, 1.0), "1",
+                    "scale of the specular term (1: the interface alone; above 1 not physical)"),
     )
     OPTIONS = {"distribution": "trowbridge-reitz", "shadowing": "smith-height-correlated"}
     _drive = _micro_drive

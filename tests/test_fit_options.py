@@ -120,7 +120,7 @@ def test_every_option_of_fit_is_a_field_with_the_same_default():
     fields = {f.name: f.default for f in dataclasses.fields(FitOptions)}
     assert fields["loss"] == "relative" and fields["starts"] == 8 and fields["seed"] == 0
     assert fields["subsample"] == 1000 and fields["aperture_points"] == 19
-    assert len(fields) == 25 and "model" not in fields and "measurement" not in fields
+    assert len(fields) == 26 and fields["energy_constraint"] is True and "model" not in fields and "measurement" not in fields
     assert FitOptions().changed() == {} and FitOptions(fix=[]).changed() == {}
 
 

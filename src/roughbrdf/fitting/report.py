@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING
 from ..errors import ArgumentError
 from ..quantity import Loss
 from .data import excluded_text
+from .physical import report_lines
 
 if TYPE_CHECKING:
     from .result import ChannelFit, FitResult
@@ -229,6 +230,7 @@ def _variables(c: ChannelFit, angles: str = "rad") -> list[str]:
                       f"is no physical limit:",
                       "     the value is where the search stopped, not a result (widen the "
                       "bounds or change the model)"]
+    lines += report_lines(c)  # a search range beyond the physical one (fitting.physical)
     if c.free_scale:
         lines.append(f"    {'scale K':<{width}}: {fmt(c.scale, 7)} +/- "
                      f"{fmt(c.scale_stderr, 4)}{percent(c.scale_stderr, c.scale)} (closed form)")

@@ -25,6 +25,7 @@ from ..instrument import Aperture, aperture_average
 from ..jsonsafe import clean_json
 from ..quantity import Quantity
 from .data import input_source
+from .physical import non_physical
 from .plausibility import Plausibility, channel_plausibility
 from .statistics import Covariance, GoodnessOfFit, at_bound, limit_kinds
 
@@ -201,7 +202,7 @@ class ChannelFit:
         """This channel's entry of ``fit.json`` (before NaN -> null)."""
         return {"channel": self.channel, "params": self.params, "stderr": self.stderr,
                 "at_bound": self.at_bound, "limits": self.limits, "success": bool(self.success),
-                "metrics": self.metrics,
+                "metrics": self.metrics, "non_physical_range": non_physical(self),
                 "message": self.message, "free": self.free, "init": self.init,
                 "bounds": {k: list(v) for k, v in self.bounds.items()}, "scale": self.scale,
                 "scale_stderr": self.scale_stderr, "correl": self.correl,
@@ -583,14 +584,14 @@ def channel_model(fit: dict[str, Any], chan: dict[str, Any]) -> Model:
     """The fitted model of one channel entry of ``fit.json`` (its ``model_spec``; a fit.json
     of an older roughbrdf: the model's name and the channel's ``params``)."""
     from ..models import model as make_model
+    from ..models.coated import legacy_spec  # coated ks of roughbrdf 0.1.0: weights="free"
 
     spec = chan.get("model_spec")
-    if isinstance(spec, dict):
-        return make_model(spec)
-    name = fit["model"]
-    if isinstance(name, dict):
-        return make_model(name, **(chan.get("params") or {}))
-    return make_model(str(name), **(chan.get("params") or {}))
+    if not isinstance(spec, dict):  # an older fit.json: the model's name and the params
+        name, params = fit["model"], chan.get("params") or {}
+        spec = ({**name, "params": {**name.get("params", {}), **params}}
+                if isinstance(name, dict) else {"model": str(name), "params": params})
+    return make_model(legacy_spec(spec))
 
 
 def fitted_models(fit: str | os.PathLike) -> dict[str, Model]:

@@ -419,3 +419,48 @@ class Coated(Model):
 
     def _mueller(self, g: PreparedGeometry, basis: int, term: str | None) -> np.ndarray:
         return self._mueller_drive(_coated_mueller_drive, g, self._pack(), basis, term)
+
+
+class LegacyCoatedWarning(UserWarning):
+    """A saved fit of the coated model with free lobe scales (``ks``), from before the lobes'
+    weights summed to 1: rebuilt with ``weights="free"`` (:func:`legacy_spec`)."""
+
+
+def _legacy_entry(spec: dict[str, Any]) -> tuple[dict[str, Any], bool]:
+    if spec.get("model") == "sum":
+        parts = [_legacy_entry(c) for c in spec.get("components", [])]
+        return {**spec, "components": [p for p, _ in parts]}, any(old for _, old in parts)
+    name = str(spec.get("model", "")).split("(")[0].strip().lower()
+    options, params = dict(spec.get("options") or {}), spec.get("params") or {}
+    is_coated = name in (Coated.name, *Coated.aliases)
+    # a coated model with a free scale and no weights option: written before the option
+    if is_coated and "ks" in params and "weights" not in options:
+        return {**spec, "options": {**options, "weights": "free"}}, True
+    return spec, False
+
+
+def legacy_spec(spec: dict[str, Any]) -> dict[str, Any]:
+    """A stored model spec (``Model.to_dict()``, or ``{"model": name, "params": ...}``) as the
+    current coated model reads it: a coated entry with ``ks`` and no ``weights`` option (a
+    fit.json or catalogue of roughbrdf 0.1.0) gets ``weights="free"``, its old free lobe
+    scales, with a :class:`LegacyCoatedWarning` (one line). Other specs are returned as they
+    are.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as w:
+    ...     warnings.simplefilter("always")
+    ...     legacy_spec({"model": "coated", "params": {"ks": 20.0}})["options"]
+    ...     print(w[0].message)
+    {'weights': 'free'}
+    the fit predates energy-conserving coated lobes (free lobe scales ks): rebuilt with ...
+    """
+    import warnings
+
+    out, old = _legacy_entry(spec)
+    if old:
+        warnings.warn("the fit predates energy-conserving coated lobes (free lobe scales ks): "
+                      "rebuilt with weights='free', which is not energy-conserving; refit for "
+                      "lobe weights that sum to 1", LegacyCoatedWarning, stacklevel=3)
+    return out

@@ -86,11 +86,11 @@ def test_the_closed_form_scale_is_the_minimum_of_the_cost(weighted):
 
 
 def _glinting_microfacet(seed: int, quantity: str = "brdf", scale: float = 1.0):
-    """A microfacet surface (alpha 0.2, ks 1) measured with 2 % noise and 8 % glints."""
+    """A microfacet surface (alpha 0.2, ks 0.5) measured with 2 % noise and 8 % glints."""
     ti, tr, ph = np.meshgrid(np.radians([0, 20, 40]), np.radians(np.arange(0, 80, 4)),
                              np.radians([0, 90, 180]), indexing="ij")
     ti, tr, ph = ti.ravel(), tr.ravel(), ph.ravel()
-    truth = rb.model("microfacet").with_params(alpha=0.2, n=1.5, k=0.0, ks=1.0)
+    truth = rb.model("microfacet").with_params(alpha=0.2, n=1.5, k=0.0, ks=0.5)
     rng = np.random.default_rng(seed)
     x = truth.brdf(ti, tr, ph) * np.exp(0.02 * rng.standard_normal(ti.size))
     glint = rng.random(ti.size) < 0.08
@@ -104,16 +104,16 @@ def test_a_fit_with_outliers_recovers_the_truth_better_than_the_log_loss():
     for loss in ("log", "robust"):
         res = rb.fit("microfacet", meas, loss=loss, fix=["n", "k"], starts=2, progress=False)
         assert res.success
-        err[loss] = max(abs(res.params["alpha"] - 0.2) / 0.2, abs(res.params["ks"] - 1.0))
-    assert err["robust"] < 0.03 < err["log"]
-    assert err["robust"] < err["log"] / 3
+        err[loss] = max(abs(res.params["alpha"] - 0.2) / 0.2,
+                        abs(res.params["ks"] - 0.5) / 0.5)
+    assert err["robust"] < 0.03 < 0.1 < err["log"]           # log: ks about 18 % high
 
 
 def test_relative_data_get_their_scale_back_despite_outliers():
     meas = _glinting_microfacet(5, quantity="relative", scale=7.0)
     res = rb.fit("microfacet", meas, loss="robust", fix=["n", "k", "ks"], starts=2,
-                 progress=False)
-    assert res[0].scale == pytest.approx(1 / 7.0, rel=0.03)
+                 progress=False)                             # ks stays at its default, 1
+    assert res[0].scale == pytest.approx(1 / (7.0 * 0.5), rel=0.03)
     assert res.params["alpha"] == pytest.approx(0.2, rel=0.03)
     assert "loss               = robust, soft-L1" in res.report()
 

@@ -60,7 +60,7 @@ HELD_OUT_DEG = 60.0
 #: known parameters of the synthetic sets (only the names the model has; the rest keep the
 #: model's defaults, so the script runs whatever the model's parameterization)
 TRUTH = {"coated": {"n": 1.5, "rho": 0.05, "alpha": 0.1},
-         "microfacet": {"alpha": 0.2, "n": 1.5, "k": 0.5},
+         "microfacet": {"alpha": 0.2, "n": 1.5, "k": 0.5, "ks": 0.5},
          "tr75": {"e": 0.3, "n": 1.5, "k": 0.2, "rho_L": 0.05}}
 NOISE_LOG = 0.05
 NOISE_FLOOR = 1e-3

@@ -166,23 +166,44 @@ def test_three_term_sum_nests_blends():
 @pytest.mark.parametrize("dist_, alpha, rho", [("ggx", 0.1, 0.5), ("ggx", 0.5, 1.0),
                                               ("ggx", 1.2, 0.8), ("beckmann", 0.05, 0.9)])
 def test_coated_rough_interface_is_roughplastic(dist_, alpha, rho):
-    m = rb.model("coated", distribution=dist_, alpha=alpha, n=1.5, rho=rho, ks=0.9,
+    # one lobe has weight 1: specular_reflectance 1; weights="free" maps its free scale ks
+    m = rb.model("coated", distribution=dist_, alpha=alpha, n=1.5, rho=rho,
                  shadow_diffuse=False, interface="rough")
     e = check_exact(m, 7)
     b = e.bsdf
     assert (b["type"], b["int_ior"], b["ext_ior"], b["nonlinear"]) == (
         "roughplastic", 1.5, 1.0, True)
+    assert (b["diffuse_reflectance"], b["specular_reflectance"]) == (rho, 1.0)
+    free = rb.model("coated", distribution=dist_, alpha=alpha, n=1.5, rho=rho, ks=0.9,
+                    shadow_diffuse=False, interface="rough", weights="free")
+    b = check_exact(free, 7).bsdf
     assert (b["diffuse_reflectance"], b["specular_reflectance"]) == (rho, 0.9)
 
 
 def test_coated_lobes_in_a_sum():
-    # lobes 2 and 3 are roughconductor lobes of the coating's index; in a blend the substrate
-    # term is scaled through roughplastic's nonlinear diffuse reflectance
+    # weights="free": lobes 2 and 3 are roughconductor lobes of the coating's index (the
+    # substrate sees lobe 1's interface); in a blend the substrate term is scaled through
+    # roughplastic's nonlinear diffuse reflectance
     m = rb.model("coated", alpha=0.08, n=1.45, rho=0.85, ks=0.7, lobes=3, alpha2=0.3, ks2=0.2,
-                 alpha3=0.9, ks3=0.1, shadow_diffuse=False, interface="rough") + rb.model(
-        "lambertian", rho=0.1)
+                 alpha3=0.9, ks3=0.1, shadow_diffuse=False, interface="rough",
+                 weights="free") + rb.model("lambertian", rho=0.1)
     e = check_exact(m, 8)
     assert e.terms[""][0].plugins == ("roughplastic", "roughconductor", "roughconductor")
+
+
+def test_coated_lobe_weights_are_blended_roughplastics():
+    # lobe weights that sum to 1: one roughplastic per lobe, each scaled by its weight (the
+    # model's substrate sees the lobes' mixed interface: approximate, a small deviation);
+    # with one width for both lobes the mixture is the one lobe, and the export exact
+    m = rb.model("coated", alpha=0.08, n=1.45, rho=0.85, lobes=2, alpha2=0.3, w2=0.3,
+                 shadow_diffuse=False, interface="rough")
+    e = export_mitsuba(m)
+    assert e.terms[""][0].plugins == ("roughplastic", "roughplastic")
+    assert e.status == "approximate" and e.deviation[""].max < 0.05
+    assert "mixed rough interface" in e.terms[""][0].note
+    reported_matches_mitsuba(e, m)
+    same = m.with_params(alpha2=0.08)
+    assert export_mitsuba(same).status == "exact"
 
 
 def test_oren_nayar_with_sigma_zero_is_diffuse():
@@ -332,8 +353,9 @@ def test_sum_fits_only_the_part_that_does_not_map():
 def three_channels():
     rng = np.random.default_rng(0)
     ti, tr, ph = rng.uniform(0, 1.3, 300), rng.uniform(0, 1.3, 300), rng.uniform(0, np.pi, 300)
+    # weights="free" (ks + ks2 = 1): roughplastic + roughconductor, an exact export
     base = rb.model("coated", alpha=0.2, n=1.5, rho=0.5, shadow_diffuse=False,
-                    interface="rough", lobes=2, alpha2=0.5, ks2=0.3)
+                    interface="rough", lobes=2, alpha2=0.5, ks=0.7, ks2=0.3, weights="free")
     alphas, rhos = (0.2, 0.21, 0.23), (0.1, 0.5, 0.9)  # 630, 525, 465 nm
     vals = np.stack([base.with_params(alpha=a, rho=r).brdf(ti, tr, ph)
                      for a, r in zip(alphas, rhos, strict=True)], 1)

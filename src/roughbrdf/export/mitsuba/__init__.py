@@ -21,8 +21,13 @@ roughbrdf                         Mitsuba 3
 ``ks`` (``n=None``: F = 1)        (``eta = 0``, ``k = 1``: Mitsuba's ``material="none"``, F = 1)
 ``coated``, ``smith-separable``,  ``roughplastic`` (``int_ior = n``, ``ext_ior = 1``,
 ``shadow_diffuse=False``,         ``diffuse_reflectance = rho``, ``nonlinear = true``,
-``interface="rough"``             ``specular_reflectance = ks``, ``alpha``); lobes 2 and 3 are
-                                  ``roughconductor`` lobes (``eta = n``, ``k = 0``) blended in
+``interface="rough"``, one lobe   ``specular_reflectance = 1``, ``alpha``)
+``coated`` as above, 2-3 lobes    one ``roughplastic`` per lobe, blended by the lobe weights:
+                                  *approximate* (the model's substrate sees the lobes' mixed
+                                  interface, each ``roughplastic`` its own lobe's)
+``coated`` ``weights="free"``     ``roughplastic`` with ``specular_reflectance = ks``; lobes 2
+                                  and 3 ``roughconductor`` lobes (``eta = n``, ``k = 0``,
+                                  ``specular_reflectance = ks_j``) blended in
 ``trowbridge-reitz-1975``         ``roughconductor`` GGX with ``alpha = e`` + ``diffuse``
                                   ``rho_L``: *approximate*, see below
 sums ``m1 + m2 + ...``            nested ``blendbsdf`` (below)

@@ -82,12 +82,16 @@ def _conductor(dcode: int, alpha: float, n: float | None, k: float | None, ks: f
                  (("eta", _arr(eta)), ("k", _arr(kk)), ("specular_reflectance", _arr(ks))))
 
 
-def _plastic(dcode: int, alpha: float, n: float, rho: float, ks: float, where: str) -> Leaf:
+def _plastic(dcode: int, alpha: float, n: float, rho: float, ks: float, where: str,
+             c: float = 1.0) -> Leaf:
+    """A ``roughplastic``; ``c`` scales its substrate term (nonlinear diffuse reflectance
+    ``c rho/(1 + (c - 1) rho F_int)``, as :meth:`Leaf.scaled`)."""
     f_int = rough_interface(alpha, n, dist.get(MITSUBA_DISTRIBUTIONS[dcode]).name, g1="mitsuba")[1]
+    rho_c = c * rho / (1.0 + (c - 1.0) * rho * f_int)
     return Leaf("roughplastic", (("distribution", MITSUBA_DISTRIBUTIONS[dcode]),
                                   ("alpha", _check_alpha(alpha, where)), ("int_ior", float(n)),
                                   ("ext_ior", 1.0), ("nonlinear", True)),
-                 (("diffuse_reflectance", _arr(rho)), ("specular_reflectance", _arr(ks))),
+                 (("diffuse_reflectance", _arr(rho_c)), ("specular_reflectance", _arr(ks))),
                  f_int)
 
 
@@ -156,15 +160,26 @@ def leaves_of(m: Model, where: str) -> list[Leaf]:
                            v["ks"], where)]
     if m.name == "trowbridge-reitz-1975":  # TR75's distribution is GGX with alpha = e
         return [_conductor(dist.TR, v["e"], v["n"], v["k"], 1.0, where), _diffuse(v["rho_L"])]
-    d = dist.get(o["distribution"]).code  # coated: roughplastic + a conductor per extra lobe
-    out = [_plastic(d, v["alpha"], v["n"], v["rho"], v["ks"], where)]
-    for j in range(2, o["lobes"] + 1):
-        out.append(_conductor(d, v[f"alpha{j}"], v["n"], 0.0, v[f"ks{j}"], where))
-    return out
+    d = dist.get(o["distribution"]).code
+    lobes = m.specular_lobes()  # type: ignore[attr-defined]
+    if o.get("weights") == "free" or len(lobes) == 1:
+        # the substrate sees lobe 1's interface: roughplastic (specular_reflectance = its
+        # weight, 1 for one lobe) + a conductor of the coating's index per extra lobe
+        out = [_plastic(d, v["alpha"], v["n"], v["rho"], lobes[0][0], where)]
+        out += [_conductor(d, a, v["n"], 0.0, w, where) for w, a in lobes[1:]]
+        return out
+    # several lobes of one interface (weights sum to 1): one roughplastic per lobe, its
+    # specular part and its substrate term scaled by the lobe's weight; the model's substrate
+    # sees the lobes' mixed tables instead (approximate, note_for)
+    return [_plastic(d, a, v["n"], v["rho"], w, where, c=w) for w, a in lobes]
 
 
 def note_for(m: Model, status: str) -> str:
     beckmann = m.options.get("distribution") == "beckmann"
+    if m.name == "coated" and m.options["lobes"] > 1 and m.options.get("weights") != "free" \
+            and status == "approximate":
+        return ("one roughplastic per lobe, blended by weight: the model's substrate sees the "
+                "lobes' mixed rough interface, each roughplastic's its own lobe's")
     if m.name == "trowbridge-reitz-1975":
         return (f"TR75 has {'V-groove' if m.options['shadowing'] == 'v-groove' else 'no'} "
                 f"shadowing; roughconductor (GGX, alpha = e) applies Smith's separable G")

@@ -33,7 +33,8 @@ def _candidate(m: Model) -> tuple[Model, list[str], dict[str, tuple[float, float
     if m.name == "coated":
         keep = {k: v[k] for k in m.param_names if k != "sigma"}
         return make("coated", distribution=o["distribution"], shadowing="smith-separable",
-                    lobes=o["lobes"], shadow_diffuse=False, interface="rough", **keep), ["n"], {}
+                    lobes=o["lobes"], shadow_diffuse=False, interface="rough",
+                    weights=o.get("weights", "partition"), **keep), ["n"], {}
     if m.name == "microfacet":
         d = dist.get(o["distribution"])
         # Gaussian-like shapes (gaussian-angle, Sirohi) are closest to Beckmann, the others

@@ -185,3 +185,54 @@ def test_microfacet_ks_search_range_is_physical():
                 m = rb.model("microfacet", distribution=d, shadowing=s, alpha=alpha, n=2.5,
                              k=10.0, ks=1.0)
                 assert _max_albedo(m)[0] <= 1.0 + TOL
+
+
+# ------------------------------------------------------------------------------------------
+# fits saved before the change: coated with free lobe scales ks
+# ------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def legacy_fit_dir(tmp_path_factory):
+    """A fit.json as roughbrdf 0.1.0 wrote it: a real fit of the coated model with the free
+    lobe scale ``ks`` in its ``params`` and ``model_spec`` and no ``weights`` option."""
+    import json
+
+    from roughbrdf.cli import main
+
+    root = tmp_path_factory.mktemp("legacy")
+    grid = np.radians(np.mgrid[0:61:30, 0:81:10, 0:181:45].reshape(3, -1))
+    truth = rb.model("coated", n=1.5, rho=0.4, alpha=0.2)
+    data = root / "paint.csv"
+    rb.write(rb.Measurement(*grid, truth.brdf(*grid), quantity="brdf"), data)
+    assert main(["fit", str(data), "--model", "coated", "--starts", "1", "--no-plots", "-q",
+                 "--out", str(root / "new")]) in (0, 1)
+    fit = json.loads((root / "new" / "fit.json").read_text())
+    for chan in fit["channels"]:
+        chan["params"]["ks"] = 1.7
+        chan["model_spec"]["params"]["ks"] = 1.7
+        assert "weights" not in chan["model_spec"]["options"]
+    old = root / "old"
+    old.mkdir()
+    (old / "fit.json").write_text(json.dumps(fit))
+    return old
+
+
+def test_legacy_fit_loads_with_free_weights_and_a_note(legacy_fit_dir):
+    from roughbrdf.fitting.result import fitted_models
+    from roughbrdf.models.coated import LegacyCoatedWarning
+
+    with pytest.warns(LegacyCoatedWarning, match="predates energy-conserving coated lobes"):
+        models = fitted_models(legacy_fit_dir)
+    (m,) = models.values()
+    assert m.options["weights"] == "free" and m.params["ks"] == 1.7
+
+
+def test_legacy_fit_plots_and_exports(legacy_fit_dir, tmp_path, capsys):
+    from roughbrdf.cli import main
+
+    assert main(["plot", "--fit", str(legacy_fit_dir)]) == 0, capsys.readouterr().err
+    assert list(legacy_fit_dir.glob("*.png"))
+    target = tmp_path / "paint.bsdf"
+    code = main(["export", "--fit", str(legacy_fit_dir), "--to", "zemax", "--out", str(target),
+                 "--allow-energy-gain"])
+    assert code == 0, capsys.readouterr().err
+    assert list(tmp_path.glob("paint*.bsdf"))

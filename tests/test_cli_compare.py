@@ -2,10 +2,10 @@
 --joint / --shared`` (:mod:`roughbrdf.cli.compare`, :mod:`roughbrdf.cli.fit`).
 
 The input is an ASTM file written here from the coated model (``docs/models.md`` §10.3;
-``n = 1.5``, ``alpha = 0.15``, ``ks = 1``, one reflectance per channel: 0.1, 0.3, 0.6) with 2 %
-noise, so the true model is known: the comparison must rank it first. The numbers checked are
-those the library's own ``rb.compare`` / ``rb.fit`` give on the same file (tests/test_compare.py
-and tests/test_joint.py test those against independent computations).
+``n = 1.5``, ``alpha = 0.15``, one lobe of weight 1, one reflectance per channel: 0.1, 0.3,
+0.6) with 2 % noise, so the true model is known: the comparison must rank it first. The numbers
+checked are those the library's own ``rb.compare`` / ``rb.fit`` give on the same file
+(tests/test_compare.py and tests/test_joint.py test those against independent computations).
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ def files(tmp_path_factory):
     """``one.astm`` (channel g alone) and ``three.astm`` (b, g, r)."""
     d = tmp_path_factory.mktemp("input")
     g = list(np.radians(np.mgrid[10:61:25, 0:81:8, 0:181:45].reshape(3, -1)))
-    clean = np.stack([rb.model("coated", n=1.5, rho=r, alpha=0.15, ks=1.0).brdf(*g)
+    clean = np.stack([rb.model("coated", n=1.5, rho=r, alpha=0.15).brdf(*g)
                       for r in RHOS.values()], axis=1)
     vals = clean * (1 + 0.02 * np.random.default_rng(1).standard_normal(clean.shape))
     rb.write(rb.Measurement(*g, vals, channels=list(RHOS)), d / "three.astm")
@@ -110,8 +110,8 @@ def test_compare_joint(files, tmp_path):
     assert res.exit_code == 0, res.output
     d = json.loads((out / "compare.json").read_text())
     k = {r["model"]: r["k"] for r in d["candidates"]}
-    # joint: coated shares n, alpha, ks and has one rho per channel; Lambertian shares nothing
-    assert k == {"coated": 3 + 3, "lambertian": 3}
+    # joint: coated shares n, alpha and has one rho per channel; Lambertian shares nothing
+    assert k == {"coated": 2 + 3, "lambertian": 3}
 
 
 # ------------------------------------------------------------------------------------------
@@ -125,7 +125,7 @@ def test_fit_auto_writes_the_model_choice(files, tmp_path):
     d = json.loads((out / "fit.json").read_text())
     assert d["model"] == "coated" and d["model_choice"]["best"] == "coated"
     assert [r["model"] for r in d["model_choice"]["candidates"]] == ["coated", "lambertian"]
-    assert set(d["channels"][0]["params"]) == {"n", "rho", "alpha", "ks"}
+    assert set(d["channels"][0]["params"]) == {"n", "rho", "alpha"}
     assert "[[Model choice]]" in (out / "report.txt").read_text()
     assert not list(out.glob("*.png"))
 
@@ -163,7 +163,7 @@ def test_fit_joint(files, tmp_path):
     assert res.exit_code == 0, res.output
     d = json.loads((out / "fit.json").read_text())
     j = d["options"]["joint"]
-    assert j["shared"] == ["n", "alpha", "ks"] and j["n_varys"] == 6
+    assert j["shared"] == ["n", "alpha"] and j["n_varys"] == 5
     params = [ch["params"] for ch in d["channels"]]
     assert [p["channel"] for p in d["channels"]] == list(RHOS)
     for name in j["shared"]:
@@ -172,7 +172,7 @@ def test_fit_joint(files, tmp_path):
     # the same fit as the library's
     lib = rb.fit("coated", rb.read(files["three"]), joint=True, starts=2, progress=False)
     assert j["chi2"] == pytest.approx(lib.options["joint"]["chi2"], rel=1e-9)
-    assert "joint fit, shared: n, alpha, ks" in (out / "report.txt").read_text()
+    assert "joint fit, shared: n, alpha" in (out / "report.txt").read_text()
 
 
 def test_fit_joint_shared_option(files, tmp_path):
@@ -185,7 +185,7 @@ def test_fit_joint_shared_option(files, tmp_path):
 
 
 @pytest.mark.parametrize("extra, needles", [
-    (["--joint", "--shared", "bogus"], ["--shared bogus", "free: n, rho, alpha, ks"]),
+    (["--joint", "--shared", "bogus"], ["--shared bogus", "free: n, rho, alpha"]),
     (["--shared", "alpha"], ["--shared", "only a joint fit shares parameters", "--joint"]),
 ])
 def test_fit_shared_errors(files, tmp_path, extra, needles):

@@ -4,8 +4,9 @@
 Where the expected numbers come from:
 
 * synthetic data generated here from the coated model (``docs/models.md`` §10.3; ``n = 1.5``,
-  ``rho = 0.3``, ``alpha = 0.15``, ``ks = 1``) times ``1 + 0.02 N(0, 1)`` noise: the true model
-  is known, and the simpler candidates (Lambertian, Oren-Nayar) cannot make a specular lobe;
+  ``rho = 0.3``, ``alpha = 0.15``; one lobe of weight 1) times ``1 + 0.02 N(0, 1)`` noise: the
+  true model is known, and the simpler candidates (Lambertian, Oren-Nayar) cannot make a
+  specular lobe;
 * the information criteria recomputed here from each channel's residuals with the formula of
   the module notes, ``sum_c n_c ln(chi2_c/n_c) + (2 or ln N) k``;
 * the cross-validation score of the Lambertian model with the absolute loss, in closed form:
@@ -34,7 +35,7 @@ from roughbrdf.fitting.compare import (
 from roughbrdf.models import from_spec, spec_text
 from roughbrdf.models.factory import split_specs
 
-TRUTH = rb.model("coated", n=1.5, rho=0.3, alpha=0.15, ks=1.0)
+TRUTH = rb.model("coated", n=1.5, rho=0.3, alpha=0.15)
 STARTS = 2
 
 
@@ -96,7 +97,7 @@ def test_information_recomputed_from_the_channels(comparison, meas):
 def test_information_of_a_joint_fit_counts_the_joint_unknowns(meas):
     res = rb.fit("coated", meas, joint=True, starts=1, progress=False)
     k, n, _, _ = information(res)
-    assert k == res.options["joint"]["n_varys"] == 3 + 2  # n, alpha, ks + one rho each
+    assert k == res.options["joint"]["n_varys"] == 2 + 2  # n, alpha + one rho each
     assert n == 2 * meas.n_samples
 
 
@@ -148,11 +149,11 @@ def test_table_to_dict_and_plot(comparison):
                         "rms_log_by_theta_r", "cv", "params", "limits", "plausibility",
                         "elapsed_s"}
     assert set(row["params"]) == {"c0", "c1"} and set(row["params"]["c0"]) == {
-        "n", "rho", "alpha", "ks"}
+        "n", "rho", "alpha"}
     json.dumps(d)  # plain values
     lines = comparison.table().splitlines()
     assert lines[0].startswith("| model | k | sigma | rms-log | dBIC | dAIC | CV |")
-    assert lines[2].startswith("| coated | 8 |") and "| 0 | 0 |" in lines[2]
+    assert lines[2].startswith("| coated | 6 |") and "| 0 | 0 |" in lines[2]
     assert len([ln for ln in lines if ln.startswith("| ")]) == 1 + 3
     assert any(ln.startswith("- BIC and AIC assume independent residuals") for ln in lines)
     fig = comparison.plot()

@@ -53,7 +53,7 @@ def test_parameters_given_by_keyword_are_set():
 def test_spec_string_with_settings():
     m = rb.model("coated(lobes=2)")
     assert m.name == "coated" and m.options["lobes"] == 2
-    assert {"alpha2", "ks2"} <= set(m.params)
+    assert {"alpha2", "w2"} <= set(m.params)
     both = rb.model("coated(lobes=2, distribution=beckmann)", alpha=0.2)
     assert both.options["distribution"] == "beckmann" and both.params["alpha"] == 0.2
     assert rb.model("Coated( lobes = 2 )").options == m.options

@@ -4,10 +4,10 @@
 Where the expected numbers come from:
 
 * synthetic data generated here from the coated model (``docs/models.md`` §10.3) with one
-  surface -- ``n = 1.5``, ``alpha = 0.15``, ``ks = 1`` -- and one reflectance per channel
+  surface -- ``n = 1.5``, ``alpha = 0.15``, one lobe of weight 1 -- and one reflectance per channel
   (``rho = 0.1, 0.3, 0.6``), times ``1 + 0.02 N(0, 1)`` noise (seed 1): the truth is known;
 * identities of least squares: the separate fits minimize the same sum of squares with more
-  freedom (each channel its own ``n, alpha, ks``), so the joint chi2 is not below their sum;
+  freedom (each channel its own ``n, alpha``), so the joint chi2 is not below their sum;
   a joint fit that shares nothing *is* the separate fits; a joint fit of one channel is the
   ordinary fit of that channel;
 * the information a shared parameter gets from every channel: its joint (unscaled) variance is
@@ -29,7 +29,7 @@ import roughbrdf as rb
 from roughbrdf.errors import ArgumentError
 from roughbrdf.fitting.compare import information
 
-SHARED_TRUE = {"n": 1.5, "alpha": 0.15, "ks": 1.0}
+SHARED_TRUE = {"n": 1.5, "alpha": 0.15}
 RHO_TRUE = {"b": 0.1, "g": 0.3, "r": 0.6}
 STARTS = 2
 
@@ -69,7 +69,7 @@ def test_joint_recovers_the_shared_parameters_and_each_reflectance(joint):
             assert c.params[name] == joint.channels[0].params[name]  # one value for all
             assert abs(c.params[name] - true) <= 4 * c.stderr[name], (c.channel, name)
         assert abs(c.params["rho"] - RHO_TRUE[c.channel]) <= 4 * c.stderr["rho"], c.channel
-        assert "joint fit of 3 channels, shared: n, alpha, ks" in c.message
+        assert "joint fit of 3 channels, shared: n, alpha" in c.message
 
 
 def test_stderr_finite_and_shared_ones_equal_across_channels(joint):
@@ -94,8 +94,8 @@ def test_covar_and_correl_are_the_joint_ones(meas):
     normalized."""
     rel = rb.Measurement(*_grid(), meas.values / meas.values[0], channels=list(RHO_TRUE),
                          quantity="relative")
-    # coated's ks is an overall scale of the lobe: with a free data scale, fix it (rb.fit notes)
-    res = rb.fit("coated", rel, joint=True, fix=["ks"], starts=STARTS, progress=False)
+    # (the lobe has weight 1: no scale of its own that the free data scale would duplicate)
+    res = rb.fit("coated", rel, joint=True, starts=STARTS, progress=False)
     for c in res.channels:
         sd = np.sqrt(np.diag(c.covar))
         np.testing.assert_allclose(sd, [c.stderr[n] for n in c.free] + [c.scale_stderr],
@@ -119,7 +119,7 @@ def test_joint_chi2_is_not_below_the_separate_fits(joint, separate):
 
 def test_sharing_nothing_is_the_separate_fits(meas, separate):
     res = rb.fit("coated", meas, joint=True, shared=[], starts=STARTS, progress=False)
-    assert res.options["joint"]["shared"] == [] and res.options["joint"]["n_varys"] == 12
+    assert res.options["joint"]["shared"] == [] and res.options["joint"]["n_varys"] == 9
     assert res.options["joint"]["chi2"] == pytest.approx(
         sum(c.chi2 for c in separate.channels), rel=1e-6)
     for a, b in zip(res.channels, separate.channels, strict=True):
@@ -130,22 +130,22 @@ def test_sharing_nothing_is_the_separate_fits(meas, separate):
 def test_joint_fit_of_one_channel_is_the_ordinary_fit(meas, separate):
     one = rb.fit("coated", meas, joint=True, channel="g", starts=STARTS, progress=False)
     alone = separate["g"]
-    assert one.options["joint"]["n_varys"] == alone.n_varys == 4
+    assert one.options["joint"]["n_varys"] == alone.n_varys == 3
     assert one.channels[0].chi2 == pytest.approx(alone.chi2, rel=1e-6)
     for name in alone.free:
         assert one.channels[0].params[name] == pytest.approx(alone.params[name], rel=1e-5)
 
 
 @pytest.mark.parametrize("shared, fix, n_varys", [
-    (None, (), 3 + 3 * 1),            # n, alpha, ks shared; rho per channel
-    (["alpha"], (), 1 + 3 * 3),       # n, rho, ks per channel
-    (["ks", "alpha", "n"], (), 6),    # any order: stored in the model's order
-    (None, ("ks",), 2 + 3 * 1),
+    (None, (), 2 + 3 * 1),            # n, alpha shared; rho per channel
+    (["alpha"], (), 1 + 3 * 2),       # n, rho per channel
+    (["alpha", "n"], (), 5),          # any order: stored in the model's order
+    (None, ("n",), 1 + 3 * 1),
 ])
 def test_n_varys_bookkeeping(meas, shared, fix, n_varys):
     res = rb.fit("coated", meas, joint=True, shared=shared, fix=fix, starts=1, progress=False)
     j = res.options["joint"]
-    expected_shared = [n for n in ("n", "alpha", "ks") if n not in fix and (
+    expected_shared = [n for n in ("n", "alpha") if n not in fix and (
         shared is None or n in shared)]
     assert j["shared"] == expected_shared
     assert j["n_varys"] == n_varys and j["n_points"] == 3 * meas.n_samples
@@ -167,7 +167,7 @@ def test_n_varys_bookkeeping(meas, shared, fix, n_varys):
 def test_relative_data_add_one_scale_per_channel(meas):
     rel = rb.Measurement(*_grid(), meas.values / meas.values[0], channels=list(RHO_TRUE),
                          quantity="relative")
-    res = rb.fit("coated", rel, joint=True, fix=["ks"], starts=1, progress=False)
+    res = rb.fit("coated", rel, joint=True, starts=1, progress=False)
     assert res.options["joint"]["n_varys"] == 2 + 3 + 3
     assert all(c.free_scale and c.scale > 0 for c in res.channels)
 
@@ -199,10 +199,10 @@ def test_subsampled_exploration_reaches_the_full_optimum(meas, joint):
 
 def test_report_and_json(joint):
     text = joint.report()
-    assert "channels           = 3 (joint fit, shared: n, alpha, ks; 6 unknowns in all" in text
+    assert "channels           = 3 (joint fit, shared: n, alpha; 5 unknowns in all" in text
     d = json.loads(joint.to_json())
-    assert d["options"]["joint"]["shared"] == ["n", "alpha", "ks"]
-    assert d["options"]["joint"]["n_varys"] == 6
+    assert d["options"]["joint"]["shared"] == ["n", "alpha"]
+    assert d["options"]["joint"]["n_varys"] == 5
     assert [ch["params"]["alpha"] for ch in d["channels"]] == [
         joint.channels[0].params["alpha"]] * 3
     assert rb.fit("coated", rb.Measurement(*_grid(), _values()[:, 0]), starts=1,
@@ -221,13 +221,13 @@ def test_unknown_shared_name_is_refused(meas, shared, bad):
     with pytest.raises(ArgumentError) as info:
         rb.fit("coated", meas, joint=True, shared=shared, starts=1, progress=False)
     assert info.value.argument == "shared" and info.value.value == bad
-    assert "free: n, rho, alpha, ks" in str(info.value)
+    assert "free: n, rho, alpha" in str(info.value)
 
 
 def test_a_fixed_parameter_cannot_be_shared(meas):
     with pytest.raises(ArgumentError) as info:
         rb.fit("coated", meas, joint=True, shared=["n"], fix=["n"], starts=1, progress=False)
-    assert info.value.argument == "shared" and "free: rho, alpha, ks" in str(info.value)
+    assert info.value.argument == "shared" and "free: rho, alpha" in str(info.value)
 
 
 @pytest.mark.parametrize("bad", ["yes", 1, None])

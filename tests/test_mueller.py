@@ -350,7 +350,7 @@ def test_coated_substrate_leaves_partly_p_polarized():
     # the substrate light crosses the interface on the way out: for unpolarized incident light
     # the reflected Q/I is (R_p - R_s)/(2 - R_s - R_p) at theta_r (p-polarized, Q < 0), Fresnel
     # reflectances of the coating's index (module notes of coated.py)
-    m = rb.model("coated", rho=0.8, ks=0.0, n=1.5)
+    m = rb.model("coated", rho=0.8, ks=0.0, n=1.5, weights="free")  # the substrate alone
     tr = np.radians([10.0, 40.0, 70.0])
     M = m.mueller(0.3, tr, 2.0)
     r_s = rb.fresnel.reflectance(np.cos(tr), 1.5, 0.0, "s")

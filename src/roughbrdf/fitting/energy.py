@@ -314,12 +314,23 @@ def conditional_covariance(fit: ChannelFit, obj: Objective, active: list[int]) -
 def _round(obj: ConstrainedObjective, theta: np.ndarray, accurate: np.ndarray,
            max_nfev: int | None) -> tuple[Any, np.ndarray]:
     """One refit from ``theta`` with the fast albedo corrected to ``accurate`` there; returns
-    the local fit and the accurate albedo at its end."""
+    the local fit and the accurate albedo at its end.
+
+    The refit has :data:`ROUND_NFEV` evaluations per parameter; when that brings the albedo
+    to 1 but stops on the budget, it is finished with the polish's full budget (``max_nfev``,
+    default 100 per parameter) so that the result is a converged constrained optimum."""
     obj.bias = accurate - fast_albedo(obj.model_at(theta))
     obj.watch = np.flatnonzero(~(accurate < WATCH))  # NaN watched too
     budget = ROUND_NFEV * theta.size
     res = polish_fit(obj, theta, budget if max_nfev is None else min(max_nfev, budget))
-    return res, albedo_by_incidence(obj.model_at(res.x), EXPORT_INCIDENCES_DEG)
+    accurate = albedo_by_incidence(obj.model_at(res.x), EXPORT_INCIDENCES_DEG)
+    if res.status == 0 and not np.nanmax(accurate) > 1 + ENERGY_TOLERANCE:
+        # status 0: stopped on the budget (scipy and bounded_lm); the weights stay
+        done = polish_fit(obj, np.asarray(res.x, dtype=float), max_nfev)
+        after = albedo_by_incidence(obj.model_at(done.x), EXPORT_INCIDENCES_DEG)
+        if not np.nanmax(after) > 1 + ENERGY_TOLERANCE:  # else the capped round stands
+            return done, after
+    return res, accurate
 
 
 def constrain_channel(spec: ObjectiveSpec, data: ChannelData, outcome: SearchOutcome,

@@ -276,7 +276,8 @@ def _candidate(label: str, cv: float | None, bic: float, albedo: float = 0.5):
     from roughbrdf.fitting.compare import Candidate
 
     plaus = SimpleNamespace(max_albedo=albedo)
-    res = SimpleNamespace(channels=[None], plausibility=lambda i: plaus)
+    chan = SimpleNamespace(channel="c", model=rb.model("lambertian"), free=["rho"], params={})
+    res = SimpleNamespace(channels=[chan], options={}, plausibility=lambda i: plaus)
     return Candidate(label, res, 3, 100, bic, bic, 0.1, 0.1, {}, cv)
 
 
@@ -302,3 +303,26 @@ def test_rank_by_score_bic_beside_energy_gain_last():
     # NaN (a single incidence) is no score either
     ranked, criterion = rank([_candidate("a", math.nan, -10.0), _candidate("b", 0.1, -5.0)])
     assert criterion == "bic" and [c.label for c in ranked] == ["a", "b"]
+
+
+@pytest.mark.parametrize(("w2", "off"), [(0.0, 2), (1.0, 1)])
+def test_a_lobe_below_1e_3_is_switched_off_and_not_counted(w2, off):
+    # a second lobe of weight 0 (w2 = 0) or a first lobe of weight 0 (w2 = 1), w2 held there:
+    # the idle lobe's width is fitted but shapes nothing -- k counts one unknown less
+    from roughbrdf.fitting.compare import lobes_off
+
+    meas = _measurement()
+    res = rb.fit(rb.model("coated", lobes=2, w2=w2), meas, fix=["w2"], starts=1,
+                 progress=False)
+    (chan,) = res.channels
+    assert lobes_off(res) == [(chan.channel, off, 0.0, 1)]
+    k, _, _, _ = information(res)
+    assert k == chan.n_varys - 1
+    cmp = rb.compare(meas, [rb.model("coated", lobes=2, w2=w2)], fix=["w2"], cv=False, starts=1)
+    assert cmp.best.k == chan.n_varys - 1
+    assert any(f"lobe {off} in {chan.channel} (weight 0) below 0.001: switched off" in n
+               for n in cmp.notes)
+    # a lobe of weight above the limit stays counted
+    used = rb.fit(rb.model("coated", lobes=2, w2=0.3), meas, fix=["w2"], starts=1,
+                  progress=False)
+    assert lobes_off(used) == [] and information(used)[0] == used.channels[0].n_varys

@@ -18,10 +18,15 @@ all channels, free data scales included; for a joint fit the joint count)::
 
     AIC = sum_c n_c ln(chi2_c/n_c) + 2 k        BIC = sum_c n_c ln(chi2_c/n_c) + ln(N) k
 
-i.e. Gaussian residuals with one variance per channel. **BIC over thousands of correlated
-samples exaggerates differences**: it assumes independent residuals, but neighbouring samples
-of a goniometer share the model's systematic misfit, so ``N`` overstates the information and a
-difference of hundreds of BIC units can come from a detail of the lobe shape. The
+i.e. Gaussian residuals with one variance per channel. A specular lobe whose weight ends below
+:data:`LOBE_OFF` (a coated candidate's :meth:`~roughbrdf.models.coated.Coated.specular_lobes`)
+is switched off: its width and weight no longer shape the model, so ``k`` does not count them
+and the candidate counts as the smaller model (:func:`lobes_off`).
+
+**BIC over thousands of correlated samples exaggerates differences**: it assumes independent
+residuals, but neighbouring samples of a goniometer share the model's systematic misfit, so
+``N`` overstates the information and a difference of hundreds of BIC units can come from a
+detail of the lobe shape. The
 cross-validation score asks a different question -- how well does a model fitted without one
 incidence predict that incidence -- and is the better guide when the two disagree.
 
@@ -59,7 +64,7 @@ if TYPE_CHECKING:
     from .result import FitResult
 
 __all__ = ["AUTO_CANDIDATES", "THETA_R_BANDS", "Candidate", "ModelComparison", "choice_notes",
-           "compare", "cross_validate", "fit_auto", "information", "rank"]
+           "compare", "cross_validate", "fit_auto", "information", "LOBE_OFF", "lobes_off", "rank"]
 
 #: the candidates of ``--model auto`` for non-retroreflective materials (paints, plastics,
 #: coatings, ceramics): TR75 as published, then the coated model with one and two specular
@@ -72,6 +77,9 @@ AUTO_CANDIDATES: tuple[str, ...] = (
     "coated(lobes=2)",
     "coated(lobes=2, distribution=beckmann)",
 )
+
+#: a specular lobe whose weight ends below this is switched off (not counted in ``k``)
+LOBE_OFF = 1e-3
 
 #: bands of theta_r (degrees) of the residual table: [low, high)
 THETA_R_BANDS: tuple[tuple[float, float], ...] = (
@@ -237,11 +245,36 @@ def _num(v: float) -> str:
     return "-" if not math.isfinite(v) else f"{v:.3f}"
 
 
+def lobes_off(result: FitResult) -> list[tuple[str, int, float, int]]:
+    """``(channel, lobe number from 1, weight, unknowns)`` of each specular lobe whose fitted
+    weight is below :data:`LOBE_OFF` (module notes); ``unknowns``: the fitted parameters that
+    only that lobe needed (its width; its share ``w<j>``, or the share pinned at 1 that turned
+    lobe 1 off; with ``weights="free"`` its ``ks<j>``). ``[]`` for models without several
+    lobes. A joint fit's lobes are shared: counted once."""
+    out = []
+    chans = result.channels[:1] if result.options.get("joint") else result.channels
+    for c in chans:
+        lobes = c.model.specular_lobes() if hasattr(c.model, "specular_lobes") else []
+        if len(lobes) < 2:
+            continue
+        free = set(c.free)
+        for j, (weight, _alpha) in enumerate(lobes, start=1):
+            if not weight < LOBE_OFF:
+                continue
+            sfx = "" if j == 1 else str(j)
+            own = {"alpha" + sfx, "ks" + sfx} | ({f"w{j}"} if j > 1 else {
+                nm for nm in ("w2", "w3") if (c.params.get(nm) or 0.0) >= 1 - LOBE_OFF})
+            out.append((str(c.channel), j, float(weight), len(own & free)))
+    return out
+
+
 def information(result: FitResult) -> tuple[int, int, float, float]:
-    """``(k, N, AIC, BIC)`` of a fit over all its channels (module notes)."""
+    """``(k, N, AIC, BIC)`` of a fit over all its channels (module notes; a lobe switched
+    off, :func:`lobes_off`, does not count its width and weight)."""
     joint = result.options.get("joint")
     n = sum(c.n_points for c in result.channels)
     k = joint["n_varys"] if joint else sum(c.n_varys for c in result.channels)
+    k -= sum(off[3] for off in lobes_off(result))
     like = sum(c.n_points * math.log(c.chi2 / c.n_points) if c.chi2 > 0 else -math.inf
                for c in result.channels)
     return k, n, like + 2 * k, like + math.log(n) * k
@@ -432,8 +465,10 @@ def rank(rows: Sequence[Candidate]) -> tuple[list[Candidate], str]:
     cv = all(c.cv is not None and math.isfinite(c.cv) for c in rows)
     criterion = "cv" if cv else "bic"
 
-    def key(c: Candidate) -> tuple[bool, float]:
-        return c.gains_energy, float(c.cv) if cv else c.bic  # type: ignore[arg-type]
+    def key(c: Candidate) -> tuple[bool, float, int]:
+        # equal scores (a lobe switched off: the smaller model's fit): the fewer unknowns
+        score = float(f"{c.cv:.6g}") if cv else c.bic  # type: ignore[arg-type]
+        return c.gains_energy, score, c.k
 
     return sorted(rows, key=key), criterion
 
@@ -450,6 +485,12 @@ def choice_notes(cmp: ModelComparison) -> list[str]:
         by_cv = cmp.best_cv
         if by_cv is not None and by_cv is not best:
             notes.append(f"cross-validation prefers {by_cv.label} (ranked by BIC: {best.label})")
+    for c in cmp.candidates:
+        off = lobes_off(c.result)
+        if off:
+            what = ", ".join(f"lobe {j} in {ch} (weight {w:.1g})" for ch, j, w, _ in off)
+            notes.append(f"{c.label}: {what} below {LOBE_OFF:g}: switched off, counted as the "
+                         f"smaller model (k = {c.k})")
     if any(c.gains_energy for c in cmp.candidates):
         notes.append("candidates whose fitted model gains energy rank last, whatever their "
                      "score")

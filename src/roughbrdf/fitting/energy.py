@@ -4,7 +4,8 @@
 can reflect more than they receive for some parameter values. After a channel's search
 (:func:`roughbrdf.fitting.channels.fit_channels`), when the fitted model gains energy on the
 grid :data:`~roughbrdf.fitting.plausibility.EXPORT_INCIDENCES_DEG` (0, 5, ... 85, 89 deg;
-:func:`~roughbrdf.fitting.plausibility.energy_gain`, the accurate :func:`roughbrdf.albedo`),
+the test of :func:`~roughbrdf.fitting.plausibility.energy_gain`, the accurate
+:func:`roughbrdf.albedo`),
 the channel is refitted from that optimum under the constraint ``albedo(theta_i) <= 1`` at every
 incidence of the grid (:func:`constrain_channel`):
 
@@ -14,14 +15,18 @@ incidence of the grid (:func:`constrain_channel`):
   (:data:`FAST_ALBEDO_ACCURACY` for smooth lobes, more for lobes a few degrees wide at grazing
   incidence) is taken out by a *defect correction*: at the start of each round the difference
   accurate - fast at the current point is added to the fast albedo;
-* the residuals of the fit get one penalty residual per incidence,
-  ``W max(0, A_k(theta) - target)`` (:class:`ConstrainedObjective`, forward-difference
-  Jacobian columns), with ``W^2 = lambda * cost`` of the unconstrained optimum, and the polish
-  of :func:`~roughbrdf.fitting.search.polish_fit` runs on it unchanged;
+* the residuals of the fit get one penalty residual per watched incidence,
+  ``W max(0, A_k(theta) - target)``, ``target = 1 -`` :data:`MARGIN`
+  (:class:`ConstrainedObjective`, forward-difference Jacobian rows), with ``W^2 = lambda *
+  cost`` of the start point and ``lambda = 1 / sum(excess^2)`` in the first round; the polish
+  of :func:`~roughbrdf.fitting.search.polish_fit` runs on it unchanged, on
+  :data:`ROUND_SAMPLES` samples of the channel, :data:`ROUND_NFEV` evaluations per parameter;
 * after each round the accurate albedo is checked; while it exceeds ``1 +``
-  :data:`~roughbrdf.fitting.plausibility.ENERGY_TOLERANCE` somewhere, ``lambda`` grows tenfold and
-  the target is lowered by the excess (at most :data:`MAX_ROUNDS` rounds; then the fit says it
-  could not, and the usual :class:`~roughbrdf.fitting.plausibility.EnergyWarning` follows).
+  :data:`~roughbrdf.fitting.plausibility.ENERGY_TOLERANCE` somewhere, ``lambda`` grows by
+  :data:`GROWTH` (at most :data:`MAX_ROUNDS` rounds; then the fit says it could not, and the
+  usual :class:`~roughbrdf.fitting.plausibility.EnergyWarning` follows);
+* the round that satisfies the constraint is polished on all samples under its penalty (the
+  polish's full budget), and kept when the constraint still holds.
 
 At a constrained optimum the covariance is the data's, projected on the directions along which
 the active constraints stay constant (:func:`conditional_covariance`): the uncertainties are
@@ -41,7 +46,7 @@ import numpy as np
 from ..models.base import PreparedGeometry
 from ..polarization import Polarization
 from .objective import BAD_RESIDUAL, EPS_STEP, Objective, ObjectiveSpec
-from .plausibility import ENERGY_TOLERANCE, EXPORT_INCIDENCES_DEG, albedo_by_incidence, energy_gain
+from .plausibility import ENERGY_TOLERANCE, EXPORT_INCIDENCES_DEG, albedo_by_incidence
 from .search import SearchOutcome, polish_fit
 from .statistics import Covariance
 
@@ -74,6 +79,8 @@ MARGIN = 5e-4
 WATCH = 0.8
 #: the penalty's weight is set against a data cost of at least ``COST_FLOOR^2 N``
 COST_FLOOR = 1e-2
+#: samples of the channel the rounds fit (the best round's point is then polished on all)
+ROUND_SAMPLES = 1000
 #: residual evaluations of one round per free parameter at most (the polish's own budget is
 #: 100 per parameter: a 14-parameter RB08 refit spent 100 s per channel on C2_Black)
 ROUND_NFEV = 10
@@ -313,24 +320,95 @@ def conditional_covariance(fit: ChannelFit, obj: Objective, active: list[int]) -
 
 def _round(obj: ConstrainedObjective, theta: np.ndarray, accurate: np.ndarray,
            max_nfev: int | None) -> tuple[Any, np.ndarray]:
-    """One refit from ``theta`` with the fast albedo corrected to ``accurate`` there; returns
-    the local fit and the accurate albedo at its end.
-
-    The refit has :data:`ROUND_NFEV` evaluations per parameter; when that brings the albedo
-    to 1 but stops on the budget, it is finished with the polish's full budget (``max_nfev``,
-    default 100 per parameter) so that the result is a converged constrained optimum."""
+    """One refit of ``obj`` from ``theta`` (:data:`ROUND_NFEV` evaluations per parameter) with
+    the fast albedo corrected to ``accurate`` there; returns the local fit and the accurate
+    albedo at its end."""
     obj.bias = accurate - fast_albedo(obj.model_at(theta))
     obj.watch = np.flatnonzero(~(accurate < WATCH))  # NaN watched too
     budget = ROUND_NFEV * theta.size
     res = polish_fit(obj, theta, budget if max_nfev is None else min(max_nfev, budget))
-    accurate = albedo_by_incidence(obj.model_at(res.x), EXPORT_INCIDENCES_DEG)
-    if res.status == 0 and not np.nanmax(accurate) > 1 + ENERGY_TOLERANCE:
-        # status 0: stopped on the budget (scipy and bounded_lm); the weights stay
-        done = polish_fit(obj, np.asarray(res.x, dtype=float), max_nfev)
-        after = albedo_by_incidence(obj.model_at(done.x), EXPORT_INCIDENCES_DEG)
-        if not np.nanmax(after) > 1 + ENERGY_TOLERANCE:  # else the capped round stands
-            return done, after
-    return res, accurate
+    return res, albedo_by_incidence(obj.model_at(res.x), EXPORT_INCIDENCES_DEG)
+
+
+def _subsample(data: ChannelData) -> ChannelData:
+    """The rounds' samples: :data:`ROUND_SAMPLES` evenly spread over the channel (all when
+    there are not many more)."""
+    if data.n <= 2 * ROUND_SAMPLES:  # a small channel: the rounds see all of it
+        return data
+    return data.take(np.unique(np.linspace(0, data.n - 1, ROUND_SAMPLES).astype(np.intp)))
+
+
+@dataclass
+class _Rounds:
+    """The state of the rounds: the best point so far and what it came with."""
+
+    ok: bool = False
+    rank: float = math.inf
+    theta: np.ndarray | None = None
+    result: Any = None
+    accurate: np.ndarray | None = None
+    lam: float = 0.0
+    count: int = 0
+
+    def offer(self, ok: bool, rank: float, theta: np.ndarray, result: Any,
+              accurate: np.ndarray, lam: float) -> None:
+        """Keep this round if it satisfies the constraint at a lower cost, or if nothing
+        satisfies it yet and its albedo is lower."""
+        if self.theta is None or (not ok, rank) < (not self.ok, self.rank):
+            self.ok, self.rank, self.theta, self.result = ok, rank, theta, result
+            self.accurate, self.lam = accurate, lam
+
+
+def _run_rounds(obj: ConstrainedObjective, theta: np.ndarray, accurate: np.ndarray,
+                max_nfev: int | None, tried: list[dict[str, Any]]) -> _Rounds:
+    """The rounds on ``obj`` (the subsample) from ``theta``, ``lambda`` growing until the
+    accurate albedo is at most ``1 + ENERGY_TOLERANCE`` or :data:`MAX_ROUNDS` ran."""
+    cost0 = max(obj.cost(theta), COST_FLOOR ** 2 * obj.n)
+    excess = np.maximum(0.0, accurate - 1.0)
+    # the first weight makes the penalty at the start about the data's cost: a stronger one
+    # throws the refit far from the optimum, into a worse basin (measured on C2_Black)
+    lam = LAMBDA0 / max(float(np.sum(excess ** 2)), 1e-12)
+    obj.target = 1.0 - MARGIN
+    state = _Rounds()
+    for state.count in range(1, MAX_ROUNDS + 1):
+        obj.weight = math.sqrt(lam * cost0)
+        res, accurate = _round(obj, theta, accurate, max_nfev)
+        theta = np.asarray(res.x, dtype=float)
+        top = float(np.nanmax(accurate))
+        ok = top <= 1 + ENERGY_TOLERANCE
+        data_cost = 0.5 * float(np.sum(Objective.fun(obj, theta) ** 2))
+        tried.append({"x0": tried[-1]["x"] if tried else theta.tolist(), "x": theta.tolist(),
+                      "cost": data_cost, "stage": "energy",
+                      "origin": f"energy round {state.count}"})
+        state.offer(ok, data_cost if ok else top, theta, res, accurate, lam)
+        if ok:
+            break
+        lam *= GROWTH  # the violation the penalty leaves falls as 1/lambda
+    return state
+
+
+def _finish(spec: ObjectiveSpec, data: ChannelData, state: _Rounds, max_nfev: int | None,
+            tried: list[dict[str, Any]]) -> ConstrainedObjective:
+    """The polish of the best round's point on all samples of ``data``, with that round's
+    penalty (scaled from the subsample's cost to the full one); kept when it satisfies the
+    constraint (``state`` updated), else the round's point stands. Returns the objective."""
+    assert state.theta is not None and state.accurate is not None  # one round ran
+    full = ConstrainedObjective(spec, data, target=1.0 - MARGIN)
+    cost_full = max(full.cost(state.theta), COST_FLOOR ** 2 * data.n)
+    full.weight = math.sqrt(state.lam * cost_full)
+    if not state.ok or data.n == 0:  # nothing to finish: the rounds did not get there
+        return full
+    full.bias = state.accurate - fast_albedo(full.model_at(state.theta))
+    full.watch = np.flatnonzero(~(state.accurate < WATCH))
+    res = polish_fit(full, state.theta, max_nfev)
+    after = albedo_by_incidence(full.model_at(res.x), EXPORT_INCIDENCES_DEG)
+    if not np.nanmax(after) > 1 + ENERGY_TOLERANCE:  # else the round's point stands
+        x = np.asarray(res.x, dtype=float)
+        tried.append({"x0": state.theta.tolist(), "x": x.tolist(), "stage": "energy",
+                      "cost": 0.5 * float(np.sum(Objective.fun(full, x) ** 2)),
+                      "origin": "energy polish"})
+        state.theta, state.result, state.accurate = x, res, after
+    return full
 
 
 def constrain_channel(spec: ObjectiveSpec, data: ChannelData, outcome: SearchOutcome,
@@ -339,51 +417,29 @@ def constrain_channel(spec: ObjectiveSpec, data: ChannelData, outcome: SearchOut
     """Refit one channel under ``albedo <= 1`` on the grid when its search's optimum gains
     energy (module notes); ``(outcome, None)`` when it does not.
 
-    Returns the outcome at the constrained optimum (the refits added to ``tried`` with stage
-    ``"energy"``) and what the constraint did. The round with the lowest cost among those that
-    satisfy the constraint is kept; when none does, the one with the lowest albedo.
+    The rounds run on :data:`ROUND_SAMPLES` samples of the channel; the best round's point is
+    then polished on all of them under its penalty. Returns the outcome at the constrained
+    optimum (the refits added to ``tried`` with stage ``"energy"``) and what the constraint
+    did. The round with the lowest cost among those that satisfy the constraint is kept; when
+    none does, the one with the lowest albedo.
     """
     t0 = time.perf_counter()
-    gain = energy_gain(spec.model_at(outcome.theta))
-    if gain is None:  # conserves energy already: nothing to constrain
-        return outcome, None
-    obj = ConstrainedObjective(spec, data)
     theta = np.asarray(outcome.theta, dtype=float)
-    # the data's cost at the optimum, at least that of 1 % residuals: a near-perfect fit
-    # (synthetic data) would otherwise give the penalty no weight against the data
-    cost0 = max(obj.cost(theta), COST_FLOOR ** 2 * data.n)
+    # plausibility.energy_gain's test, on the albedo the rounds start from (computed once)
     accurate = albedo_by_incidence(spec.model_at(theta), EXPORT_INCIDENCES_DEG)
-    first_max = float(np.nanmax(accurate))
-    excess = np.maximum(0.0, accurate - 1.0)
-    # the first weight makes the penalty at the start about the data's cost: a stronger one
-    # throws the refit far from the optimum, into a worse basin (measured on C2_Black)
-    lam, target = LAMBDA0 / max(float(np.sum(excess ** 2)), 1e-12), 1.0 - MARGIN
-    best: tuple[bool, float, np.ndarray, Any, np.ndarray, float] | None = None
+    if not np.any(accurate > 1 + ENERGY_TOLERANCE):  # conserves energy: nothing to constrain
+        return outcome, None
     tried = list(outcome.tried)
-    rounds = 0
-    for rounds in range(1, MAX_ROUNDS + 1):
-        obj.weight, obj.target = math.sqrt(lam * cost0), target
-        res, accurate = _round(obj, theta, accurate, max_nfev)
-        theta = np.asarray(res.x, dtype=float)
-        top = float(np.nanmax(accurate))
-        ok = top <= 1 + ENERGY_TOLERANCE
-        data_cost = 0.5 * float(np.sum(Objective.fun(obj, theta) ** 2))
-        tried.append({"x0": tried[-1]["x"] if tried else theta.tolist(), "x": theta.tolist(),
-                      "cost": data_cost, "stage": "energy", "origin": f"energy round {rounds}"})
-        rank = (not ok, data_cost if ok else top)
-        if best is None or rank < (not best[0], best[1]):
-            best = (ok, rank[1], theta, res, accurate, target)
-        if ok:
-            break
-        lam *= GROWTH  # the violation the penalty leaves falls as 1/lambda
-    assert best is not None  # MAX_ROUNDS >= 1: one round at least
-    ok, _, theta, res, accurate, target = best
-    # active: where the penalty acts at the result (the albedo at or above that round's target)
-    active = [k for k, a in enumerate(accurate) if a >= target]
+    sub = ConstrainedObjective(spec, _subsample(data))
+    state = _run_rounds(sub, theta, accurate, max_nfev, tried)
+    full = _finish(spec, data, state, max_nfev, tried)
+    assert state.theta is not None and state.accurate is not None  # one round ran
+    # active: where the penalty acts at the result (the albedo at or above the target)
+    active = [k for k, a in enumerate(state.accurate) if a >= full.target]
     info = EnergyConstraint(
         active=bool(active), theta_deg=[float(EXPORT_INCIDENCES_DEG[k]) for k in active],
-        max_albedo=float(np.nanmax(accurate)), satisfied=ok,
-        unconstrained_max_albedo=first_max, rounds=rounds,
+        max_albedo=float(np.nanmax(state.accurate)), satisfied=state.ok,
+        unconstrained_max_albedo=float(np.nanmax(accurate)), rounds=state.count,
         elapsed=time.perf_counter() - t0)
-    out = SearchOutcome(theta, res, tried, outcome.explore_nfev + obj.nfev)
-    return out, info
+    nfev = outcome.explore_nfev + sub.nfev + full.nfev
+    return SearchOutcome(state.theta, state.result, tried, nfev), info

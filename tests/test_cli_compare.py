@@ -62,7 +62,7 @@ def test_compare_writes_the_three_files(files, tmp_path):
         assert row["bic"] == pytest.approx(cand.bic, rel=1e-9)
         assert row["cv"] == pytest.approx(cand.cv, rel=1e-9)
     md = (out / "compare.md").read_text()
-    assert md.startswith("# Model comparison: ") and "| coated | 4 |" in md
+    assert md.startswith("# Model comparison: ") and "| coated | 3 |" in md
     assert (out / "compare.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
@@ -70,7 +70,7 @@ def test_compare_without_out_writes_nothing(files, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     res = _run("compare", files["one"], "--models", MODELS, "--starts", 1, "--no-cv")
     assert res.exit_code == 0, res.output
-    assert "| coated | 4 |" in res.output and "wrote" not in res.output
+    assert "| coated | 3 |" in res.output and "wrote" not in res.output
     assert list(tmp_path.iterdir()) == []
 
 
@@ -181,7 +181,7 @@ def test_fit_joint_shared_option(files, tmp_path):
                "--shared", "n", "--starts", 1, "--no-plots", "-q", "--out", out)
     assert res.exit_code == 0, res.output
     j = json.loads((out / "fit.json").read_text())["options"]["joint"]
-    assert j["shared"] == ["n", "alpha"] and j["n_varys"] == 2 + 3 * 2
+    assert j["shared"] == ["n", "alpha"] and j["n_varys"] == 2 + 3 * 1
 
 
 @pytest.mark.parametrize("extra, needles", [

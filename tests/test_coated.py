@@ -354,12 +354,18 @@ def coated_numpy(ti, tr, ph, p, *, distribution="trowbridge-reitz", shadowing="s
     if diffuse == "oren-nayar":
         diff = diff * on_eq30(ti, tr, ph, np.pi, p["sigma"])  # the factor (rho/pi = 1)
         if not free:  # limited to what it receives: Eq. 30's albedo where it exceeds 1
-            sig = np.full_like(np.asarray(ti, dtype=float), p["sigma"])
-            diff = diff / np.maximum(1.0, np.maximum(on_albedo(np.asarray(ti, float), sig),
-                                                     on_albedo(np.asarray(tr, float), sig)))
+            diff = diff / on_cap(ti, tr, p["sigma"])
     if shadow_diffuse:
         diff = diff * rb.shadowing.smith(ti, tr, p["alpha"], distribution, shadowing)
     return spec + diff
+
+
+def on_cap(ti, tr, sigma):
+    """``max(1, albedo(theta_i), albedo(theta_r))`` of Eq. 30 per unit rho (:func:`on_albedo`):
+    what the coated substrate's Oren-Nayar factor is divided by (weights="partition")."""
+    ti, tr = np.broadcast_arrays(np.asarray(ti, float), np.asarray(tr, float))
+    sig = np.full_like(ti, sigma)
+    return np.maximum(1.0, np.maximum(on_albedo(ti, sig), on_albedo(tr, sig)))
 
 
 def _random_params(rng, lobes, diffuse):
@@ -839,7 +845,7 @@ def test_rough_interface_is_the_formula(distribution, lobes, diffuse, shadow_dif
                                   lobes=lobes, polarization=pol)
         sub = rough_substrate_numpy(ti, tr, p, distribution)  # unpolarized
         if diffuse == "oren-nayar":
-            sub = sub * on_eq30(ti, tr, ph, np.pi, p["sigma"])
+            sub = sub * on_eq30(ti, tr, ph, np.pi, p["sigma"]) / on_cap(ti, tr, p["sigma"])
         if shadow_diffuse:
             sub = sub * rb.shadowing.smith(ti, tr, p["alpha"], distribution, "smith-separable")
         np.testing.assert_allclose(m.brdf(ti, tr, ph, pol), lobes_only + sub, rtol=1e-11,

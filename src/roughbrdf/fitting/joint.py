@@ -48,7 +48,7 @@ def default_shared(model: Model, free: Sequence[str]) -> tuple[str, ...]:
     >>> import roughbrdf as rb
     >>> m = rb.model("coated", lobes=2)
     >>> default_shared(m, m.param_names)
-    ('n', 'alpha', 'ks', 'alpha2', 'ks2')
+    ('n', 'alpha', 'alpha2', 'w2')
     """
     kinds = {p.name: p.kind for p in model.parameters}
     return tuple(nm for nm in free if kinds.get(nm) != "reflectance")

@@ -85,6 +85,20 @@ def _lobe(dcode, scode, a, ks, norm, hz, ci, cr):
 
 
 @jit(inline=True)
+def _on_albedo(c, s, sigma2):
+    """``max(1, albedo(theta)/rho)`` of Oren-Nayar's Eq. 30 (``docs/models.md`` §10.2:
+    ``A + (2B/pi) [sin t (t/2 - sin 2t/4) + tan t (1 - sin^3 t)/3]``), which exceeds 1 by up to
+    1.5 % beyond 60.7 deg: the coated substrate's Eq. 30 factor is divided by it."""
+    a = 1.0 - 0.5 * sigma2 / (sigma2 + 0.33)
+    b = 0.45 * sigma2 / (sigma2 + 0.09)
+    t = math.atan2(s, c)
+    # tan t (1 - sin^3 t) -> 0 at grazing (c = 0): the stand-in 1 keeps the division finite
+    tail = s * (1.0 - s * s * s) / (c if c > 0.0 else 1.0) if c > 0.0 else 0.0
+    v = a + 2.0 * b / math.pi * (s * (0.5 * t - 0.5 * s * c) + tail / 3.0)
+    return v if v > 1.0 else 1.0
+
+
+@jit(inline=True)
 def _coated_terms(ti, tr, phi, gamma, p, dcode, rough):
     """``(F, sum_j ks_j D_j G_j/(cos theta_i cos theta_r), substrate term, cos theta_i,
     cos theta_r)``."""
@@ -106,6 +120,8 @@ def _coated_terms(ti, tr, phi, gamma, p, dcode, rough):
     if dmode > 0.0:
         sr, cp = sincos(tr)[0], sincos(phi)[1]
         diff *= oren_nayar_factor(ci, cr, si, sr, cp, sigma2)
+        if dmode > 1.5:  # Eq. 30 limited to what it receives (weights="partition")
+            diff /= max(_on_albedo(ci, si, sigma2), _on_albedo(cr, sr, sigma2))
     if dshadow > 0.0:
         diff *= ci * cr * shd.smith_g_over_cos_cos(scode, dcode, p[7], ci, cr)
     return f, spec, diff, ci, cr
@@ -413,7 +429,9 @@ class Coated(Model):
             w, a = used[j] if j < len(used) else (0.0, 1.0)
             packed += [a, w, dist.normalization(d, a)]
         return (v["n"], v["rho"], v.get("sigma", 0.0) ** 2,
-                shd.get(o["shadowing"]).code, DIFFUSE[o["diffuse"]],
+                # Oren-Nayar: 1 as published (weights="free"), 2 limited to albedo <= 1
+                shd.get(o["shadowing"]).code,
+                DIFFUSE[o["diffuse"]] * (1 if o.get("weights") == "free" else 2),
                 1.0 if o["shadow_diffuse"] else 0.0,
                 diffuse_reflectance(v["n"], internal=True), *packed, d, *self._interface(used))
 

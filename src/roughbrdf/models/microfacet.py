@@ -9,12 +9,13 @@ Cook & Torrance (1982) / Walter et al. (2007) form, built from :mod:`roughbrdf.d
 ``ks`` is an overall scale, 1 for a physical surface. Its domain is ``[0, inf)`` (it is not a
 reflectance of a part, ``roughbrdf.models.parameters``), but its search range is the physical
 ``[0, 1]``: one interface with ``F <= 1`` reflects at most what it receives (the albedo at
-``ks = 1`` is at most 1 + 1e-4 for every distribution and shadowing, ``alpha`` 0.01-2,
-``tests/test_coated_energy.py``). A fit may be given a wider range (``bounds={"ks": (0, 20)}``);
-its report and ``fit.json`` then say it used a non-physical range
-(:mod:`roughbrdf.fitting.physical`). With data of unknown scale (a free data scale ``K``) a
-lone microfacet lobe's ``ks`` and ``K`` are one degree of freedom: ``ks`` is held at its value
-(``docs/fitting.md``).
+``ks = 1`` is at most 1 + 1e-12 for every distribution with Smith or V-groove shadowing,
+``alpha`` 0.01-2, ``F = 1`` included; ``tests/test_coated_energy.py``). Without shadowing
+(``shadowing="none"``) it diverges at grazing incidence whatever ``ks``. A fit may be given a
+wider range (``bounds={"ks": (0, 20)}``); its report and ``fit.json`` then say it used a
+non-physical range (:mod:`roughbrdf.fitting.physical`). With data of unknown scale (a free
+data scale ``K``) a lone microfacet lobe's ``ks`` and ``K`` are one degree of freedom: fix
+``ks`` (``fix=["ks"]``, ``--fix ks``; ``K`` carries the scale, ``docs/fitting.md``).
 The parameter ``alpha`` is the width parameter of the chosen distribution: ``e`` for
 Trowbridge-Reitz/GGX and Berry, ``m`` for Beckmann, ``c`` (per degree) for gaussian-angle, ``A2``
 for Sirohi.

@@ -146,3 +146,13 @@ def test_cli_off_gains_energy_and_exits_1(data_file, tmp_path, capsys):
     (ch,) = content["channels"]
     assert content["options"]["energy_constraint"] is False
     assert ch["energy_constraint"] is None and ch["gains_energy"] is True
+
+
+def test_fit_batch_passes_the_option_on(data_file, tmp_path):
+    out = tmp_path / "cat"
+    assert main(["fit-batch", str(data_file), "--model", "tr75", "--out", str(out), "--starts",
+                 "2", "--no-plots", "--workers", "1", "-q", "--no-energy-constraint"]) == 1
+    (row,) = json.loads((out / "catalogue.json").read_text())["rows"]
+    assert row["status"] == "gains-energy"
+    (fit_json,) = out.glob("*/fit.json")
+    assert json.loads(fit_json.read_text())["options"]["energy_constraint"] is False

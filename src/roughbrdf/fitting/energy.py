@@ -20,13 +20,13 @@ incidence of the grid (:func:`constrain_channel`):
   (:class:`ConstrainedObjective`, forward-difference Jacobian rows), with ``W^2 = lambda *
   cost`` of the start point and ``lambda = 1 / sum(excess^2)`` in the first round; the polish
   of :func:`~roughbrdf.fitting.search.polish_fit` runs on it unchanged, on
-  :data:`ROUND_SAMPLES` samples of the channel, :data:`ROUND_NFEV` evaluations per parameter;
+  :data:`ROUND_SAMPLES` samples of the channel, at most :data:`ROUND_NFEV` evaluations;
 * after each round the accurate albedo is checked; while it exceeds ``1 +``
   :data:`~roughbrdf.fitting.plausibility.ENERGY_TOLERANCE` somewhere, ``lambda`` grows by
   :data:`GROWTH` (at most :data:`MAX_ROUNDS` rounds; then the fit says it could not, and the
   usual :class:`~roughbrdf.fitting.plausibility.EnergyWarning` follows);
-* the round that satisfies the constraint is polished on all samples under its penalty (the
-  polish's full budget), and kept when the constraint still holds.
+* the round that satisfies the constraint is polished on all samples under its penalty (at most
+  :data:`FINISH_NFEV` evaluations), and kept when the constraint still holds.
 
 At a constrained optimum the covariance is the data's, projected on the directions along which
 the active constraints stay constant (:func:`conditional_covariance`): the uncertainties are
@@ -81,9 +81,11 @@ WATCH = 0.8
 COST_FLOOR = 1e-2
 #: samples of the channel the rounds fit (the best round's point is then polished on all)
 ROUND_SAMPLES = 1000
-#: residual evaluations of one round per free parameter at most (the polish's own budget is
-#: 100 per parameter: a 14-parameter RB08 refit spent 100 s per channel on C2_Black)
-ROUND_NFEV = 10
+#: residual evaluations of one round at most (each costs a Jacobian too: one fast albedo per
+#: free parameter; 10 per parameter made a 14-parameter RB08 refit 20-45 s per C2_Black channel)
+ROUND_NFEV = 30
+#: residual evaluations of the polish on all samples at most
+FINISH_NFEV = 100
 #: (largest incidence in degrees, n_psi) of the fast quadrature: more azimuths near grazing,
 #: where the lobe is squeezed against the horizon
 N_PSI: tuple[tuple[float, int], ...] = ((60.0, 32), (75.0, 64), (90.0, 192))
@@ -320,13 +322,12 @@ def conditional_covariance(fit: ChannelFit, obj: Objective, active: list[int]) -
 
 def _round(obj: ConstrainedObjective, theta: np.ndarray, accurate: np.ndarray,
            max_nfev: int | None) -> tuple[Any, np.ndarray]:
-    """One refit of ``obj`` from ``theta`` (:data:`ROUND_NFEV` evaluations per parameter) with
+    """One refit of ``obj`` from ``theta`` (at most :data:`ROUND_NFEV` evaluations) with
     the fast albedo corrected to ``accurate`` there; returns the local fit and the accurate
     albedo at its end."""
     obj.bias = accurate - fast_albedo(obj.model_at(theta))
     obj.watch = np.flatnonzero(~(accurate < WATCH))  # NaN watched too
-    budget = ROUND_NFEV * theta.size
-    res = polish_fit(obj, theta, budget if max_nfev is None else min(max_nfev, budget))
+    res = polish_fit(obj, theta, ROUND_NFEV if max_nfev is None else min(max_nfev, ROUND_NFEV))
     return res, albedo_by_incidence(obj.model_at(res.x), EXPORT_INCIDENCES_DEG)
 
 
@@ -400,7 +401,8 @@ def _finish(spec: ObjectiveSpec, data: ChannelData, state: _Rounds, max_nfev: in
         return full
     full.bias = state.accurate - fast_albedo(full.model_at(state.theta))
     full.watch = np.flatnonzero(~(state.accurate < WATCH))
-    res = polish_fit(full, state.theta, max_nfev)
+    budget = FINISH_NFEV if max_nfev is None else min(max_nfev, FINISH_NFEV)
+    res = polish_fit(full, state.theta, budget)
     after = albedo_by_incidence(full.model_at(res.x), EXPORT_INCIDENCES_DEG)
     if not np.nanmax(after) > 1 + ENERGY_TOLERANCE:  # else the round's point stands
         x = np.asarray(res.x, dtype=float)

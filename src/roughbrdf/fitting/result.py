@@ -393,28 +393,19 @@ class FitResult:
         return c.model, meas
 
     def plot(self, channel: int | str = 0, *, fig: Any = None) -> tuple[Any, Any]:
-        """Data vs model (in-plane slices per incidence) and the residual map of one channel.
-
-        Uses :func:`roughbrdf.plot.plot_comparison` and :func:`roughbrdf.plot.plot_residual_map`
-        with the fit's aperture: the model is drawn (and the residuals taken) as the fit compared
-        it with the data. Returns ``(fig, (ax_comparison, ax_residuals))``; a new figure is a
-        pyplot-free :class:`matplotlib.figure.Figure`.
-        """
-        from .. import plot as rbplot
+        """Data vs model (in-plane slices), the residual map of each incidence and a note of the
+        samples the fit left out (:func:`roughbrdf.plot_fit.plot_fit`, the fit's aperture: the
+        model drawn as the fit compared it). Returns ``(fig, (ax_comparison,
+        ax_residuals))``; a new figure is a pyplot-free :class:`matplotlib.figure.Figure`."""
+        from ..plot_fit import plot_fit
+        from .data import excluded_text
 
         model, meas = self.plot_data(channel)
-        if fig is None:
-            from matplotlib.figure import Figure
-
-            fig = Figure(figsize=(12, 5), layout="constrained")
-        ax1 = fig.add_subplot(1, 2, 1)
-        ax2 = fig.add_subplot(1, 2, 2)
-        ap = self.instrument
-        rbplot.plot_comparison(model, meas, channel=0, ax=ax1, aperture=ap)
-        rbplot.plot_residual_map(model, meas, channel=0, ax=ax2, aperture=ap)
-        if fig.get_layout_engine() is None:  # a figure of the caller's without a layout
-            fig.tight_layout()
-        return fig, (ax1, ax2)
+        c = self[channel]
+        note = (f"{c.n_points} of {self.measurement.n_samples} samples drawn: those the fit "
+                f"used; left out: {excluded_text(c.excluded)}")
+        return plot_fit(model, meas, aperture=self.instrument, note=note, fig=fig,
+                        title=f"{self.model_name} [{c.channel}], loss {self.loss}")
 
     def plot_names(self) -> list[str]:
         """File names :meth:`save` gives the per-channel plots (``fit_<channel>.png``)."""

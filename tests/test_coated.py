@@ -344,9 +344,10 @@ def coated_numpy(ti, tr, ph, p, *, distribution="trowbridge-reitz", shadowing="s
     diff = rho / np.pi * (1 - r_i) * (1 - r_r) / (n * n * (1 - rho * fdr_int))
     if not free:
         mu = np.linspace(0.0, 1.0, 64)  # the kernel interpolates as if node 0 were at 0
-        e = sum(w * rb.diffuse.lobe_albedo(p["alpha" + ("" if j == 1 else str(j))], n,
-                                           distribution, shadowing)
-                for j, w in enumerate(weights, 1) if w > 0)
+        # (the model's tables are keyed to 7 significant digits of alpha and n)
+        e = sum(w * rb.diffuse.lobe_albedo(
+            float(f"{p['alpha' + ('' if j == 1 else str(j))]:.7g}"), float(f"{n:.7g}"),
+            distribution, shadowing) for j, w in enumerate(weights, 1) if w > 0)
         t = 1 - rb.fresnel.reflectance(rb.diffuse.TABLE_NODES, n)
         s = np.minimum(1.0, (1 - e) / t)
         s[0] = s[1]

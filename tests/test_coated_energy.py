@@ -242,12 +242,16 @@ def test_legacy_fit_loads_with_free_weights_and_a_note(legacy_fit_dir):
 
 def test_legacy_fit_plots_and_exports(legacy_fit_dir, tmp_path, capsys):
     from roughbrdf.cli import main
+    from roughbrdf.models.coated import LegacyCoatedWarning
 
-    assert main(["plot", "--fit", str(legacy_fit_dir)]) == 0, capsys.readouterr().err
+    with pytest.warns(LegacyCoatedWarning):  # the note, at the command line too
+        code = main(["plot", "--fit", str(legacy_fit_dir)])
+    assert code == 0, capsys.readouterr().err
     assert list(legacy_fit_dir.glob("*.png"))
     target = tmp_path / "paint.bsdf"
-    code = main(["export", "--fit", str(legacy_fit_dir), "--to", "zemax", "--out", str(target),
-                 "--allow-energy-gain"])
+    with pytest.warns(LegacyCoatedWarning):
+        code = main(["export", "--fit", str(legacy_fit_dir), "--to", "zemax", "--out",
+                     str(target), "--allow-energy-gain"])
     assert code == 0, capsys.readouterr().err
     assert list(tmp_path.glob("paint*.bsdf"))
 

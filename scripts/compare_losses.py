@@ -296,11 +296,12 @@ def main(argv: list[str] | None = None) -> int:
             print(f"[{time.perf_counter() - t0:6.1f} s] {msg}", file=sys.stderr, flush=True)
 
     t0 = time.perf_counter()
+    tree = commit()  # the code this run imported (the tree may move on while it runs)
     paint_rows = paints(files, starts, log)
     geometry = rb.read(files[0])
     synth_rows = synthetic(geometry.select_channel(0), seeds, starts, log)
     elapsed = time.perf_counter() - t0
-    text = report(paint_rows, synth_rows, names, seeds, starts, elapsed)
+    text = report(paint_rows, synth_rows, names, seeds, starts, elapsed, tree)
     print(text)
     if args.out is not None:
         args.out.write_text(text + "\n", encoding="utf-8")
@@ -308,7 +309,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def report(paint_rows: dict[tuple[str, str], Row], synth_rows: dict[tuple[str, str], Row],
-           names: tuple[str, ...], seeds: int, starts: int | None, elapsed: float) -> str:
+           names: tuple[str, ...], seeds: int, starts: int | None, elapsed: float,
+           tree: str) -> str:
     """The Markdown: what was run, then the two tables."""
     when = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
     truth = "; ".join(f"{m}: " + ", ".join(f"{k} = {v:g}" for k, v in
@@ -317,7 +319,7 @@ def report(paint_rows: dict[tuple[str, str], Row], synth_rows: dict[tuple[str, s
                       + (", fitted without the energy constraint)"
                          if unconstrained_if_infeasible(truth_model(m)) else ")")
                       for m in MODELS)
-    lines = [f"Run {when}, commit {commit()}, roughbrdf {rb.__version__}, "
+    lines = [f"Run {when}, commit {tree}, roughbrdf {rb.__version__}, "
              f"{elapsed:.0f} s; fits with the default options"
              + ("" if starts is None else f" but starts = {starts}")
              + ", `negative=\"drop\"`. Each cell: median (min–max).", "",

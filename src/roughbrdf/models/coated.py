@@ -248,7 +248,7 @@ def _smooth_factors(lobes: list[tuple[float, float]], n: float, distribution: st
     mu = TABLE_NODES
     e = np.zeros(ROUGH_TABLE_SIZE)
     # the tables at alpha and n to 7 significant digits: a fit's finite-difference steps
-    # (~1e-8 relative) reuse the cached table instead of building one each (1-5 ms); s moves
+    # (~1e-8 relative) reuse the cached table instead of building one each (2-6 ms); s moves
     # by far less than 1e-7 over such a step
     n7 = float(f"{n:.7g}")
     for w, a in lobes:

@@ -146,6 +146,25 @@ def _bounds_of(spec: Parameter, b: Any) -> tuple[float, float]:
     return lo, hi
 
 
+#: ``model name -> parameter`` that only scales the whole model (no other term beside it):
+#: with a free data scale ``K`` the two are one degree of freedom
+SCALE_PARAMETERS = {"microfacet": "ks"}
+
+
+def hold_scale_parameter(model: Model, fix: Any, bounds: Any, free_scale: bool
+                         ) -> tuple[Model, Any]:
+    """With a free data scale ``K`` (relative data), a model's pure scale parameter
+    (:data:`SCALE_PARAMETERS`: a lone microfacet lobe's ``ks``) is held at 1 -- ``K`` carries
+    the scale, and the two would be one degree of freedom (a singular covariance, ``ks`` on a
+    bound). Not when the user fixes it or gives it bounds, nor in a sum (there ``ks`` weighs
+    the lobe against the other terms). Returns the model and the ``fix`` list."""
+    name = SCALE_PARAMETERS.get(model.name)
+    given = [fix] if isinstance(fix, str) else list(fix or ())
+    if not free_scale or name is None or name in given or name in (bounds or {}):
+        return model, fix
+    return model.with_params(**{name: 1.0}), [*given, name]
+
+
 def data_scale(meas: Measurement, free_scale: bool | None, scale: float | None
                ) -> tuple[bool, float]:
     """``(free_scale, fixed_scale)``: a known ``scale`` is fixed; otherwise ``K`` is free for
@@ -205,7 +224,8 @@ class FitPlan:
                            o.extrapolated)
         search = o.search()
         k_free, k_fixed = data_scale(measurement, o.free_scale, o.scale)
-        params = FreeParameters.of(model, o.fix, o.bounds)
+        model, fix = hold_scale_parameter(model, o.fix, o.bounds, k_free)
+        params = FreeParameters.of(model, fix, o.bounds)
         spec = params.spec(model, loss=o.loss, quantity=opts.comparison.quantity,
                            free_scale=k_free, fixed_scale=k_fixed)
         recorded = {

@@ -25,7 +25,7 @@ from ..instrument import Aperture, aperture_average
 from ..jsonsafe import clean_json
 from ..quantity import Quantity
 from .data import input_source
-from .physical import non_physical
+from .physical import non_physical, physical_range
 from .plausibility import Plausibility, channel_plausibility
 from .statistics import Covariance, GoodnessOfFit, at_bound, limit_kinds
 
@@ -145,7 +145,8 @@ class ChannelFit:
     def limits(self) -> dict[str, str]:
         """``{name: "physical-lower" | "search-upper" ...}`` of the parameters :attr:`at_bound`
         (:func:`~roughbrdf.fitting.statistics.limit_kinds`)."""
-        return limit_kinds(self.at_bound, self.bounds, self.model.parameters)
+        return limit_kinds(self.at_bound, self.bounds, self.model.parameters,
+                           {nm: physical_range(self.model, nm) for nm in self.bounds})
 
     @property
     def metrics(self) -> dict[str, float | int]:

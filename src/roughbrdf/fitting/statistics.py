@@ -74,14 +74,18 @@ def at_bound(theta: np.ndarray, lower: np.ndarray, upper: np.ndarray, names: Seq
 
 
 def limit_kinds(at: Mapping[str, str], bounds: Mapping[str, tuple[float, float]],
-                parameters: Sequence[Any]) -> dict[str, str]:
+                parameters: Sequence[Any],
+                physical: Mapping[str, tuple[float, float] | None] | None = None
+                ) -> dict[str, str]:
     """``{name: "physical-lower" | "physical-upper" | "search-lower" | "search-upper"}`` for
     the parameters ``at`` a bound (:func:`at_bound`).
 
     ``bounds`` are the search bounds (``name -> (low, high)``), ``parameters`` the model's
     :class:`~roughbrdf.models.parameters.Parameter` objects. A bound is physical when it is the
-    parameter's domain edge on that side (to 1e-9 relative), else a search limit. A name with
-    no parameter of that name (a joint fit's ``name[channel]``) is looked up by its stem.
+    parameter's domain edge on that side (to 1e-9 relative), or the edge of its ``physical``
+    range (``name -> (low, high)``: microfacet ``ks = 1``, the most one interface reflects,
+    :func:`roughbrdf.fitting.physical.physical_range`), else a search limit. A name with no
+    parameter of that name (a joint fit's ``name[channel]``) is looked up by its stem.
 
     Examples
     --------
@@ -97,9 +101,11 @@ def limit_kinds(at: Mapping[str, str], bounds: Mapping[str, tuple[float, float]]
         lo, hi = bounds.get(nm, (math.nan, math.nan))
         b = lo if side == "lower" else hi
         edge = math.nan if par is None else par.domain[0 if side == "lower" else 2]
+        phys = (physical or {}).get(nm) or (physical or {}).get(nm.split("[")[0])
+        edges = [edge, math.nan if phys is None else phys[0 if side == "lower" else 1]]
         # an infinite edge is never reached by a finite bound; NaN (unknown) is a search limit
-        physical = math.isfinite(edge) and abs(b - edge) <= 1e-9 * max(1.0, abs(edge))
-        out[nm] = f"{'physical' if physical else 'search'}-{side}"
+        hit = any(math.isfinite(e) and abs(b - e) <= 1e-9 * max(1.0, abs(e)) for e in edges)
+        out[nm] = f"{'physical' if hit else 'search'}-{side}"
     return out
 
 

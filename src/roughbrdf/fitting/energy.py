@@ -312,11 +312,8 @@ def conditional_covariance(fit: ChannelFit, obj: Objective, active: list[int]) -
         tm[j] = max(theta[j] - h, obj.spec.lower[j])
         diff = fast_albedo(obj.model_at(tp)) - fast_albedo(obj.model_at(tm))
         grad[j] = diff[active] / (tp[j] - tm[j])
-    c, g = cov[np.ix_(keep, keep)], grad[keep]
-    cg = c @ g
-    projected = c - cg @ np.linalg.pinv(g.T @ cg) @ cg.T
     out = np.full_like(cov, np.nan)
-    out[np.ix_(keep, keep)] = projected
+    out[np.ix_(keep, keep)] = _project(cov[np.ix_(keep, keep)], grad[keep])
     conditional = Covariance(out, names)
     sd = conditional.stderr()
     stderr = dict(fit.stderr)
@@ -336,6 +333,23 @@ def checked_albedo(model: Model) -> np.ndarray:
     if near.size:  # the accurate albedo only where it can matter
         out[near] = albedo_by_incidence(model, [EXPORT_INCIDENCES_DEG[k] for k in near])
     return out
+
+
+def _project(c: np.ndarray, g: np.ndarray) -> np.ndarray:
+    """``C - C G (G^T C G)^-1 G^T C`` computed stably: in units of the standard errors, on the
+    independent directions of the gradients ``G`` (the active albedos' gradients are often
+    nearly parallel), symmetric."""
+    d = np.sqrt(np.diag(c))
+    d = np.where(d > 0, d, 1.0)  # a parameter without variance keeps its unit
+    cn = c / np.outer(d, d)
+    u, sv, _ = np.linalg.svd(g * d[:, None], full_matrices=False)
+    if sv.size == 0 or not sv[0] > 0:  # no gradient: nothing is pinned
+        return c
+    q = u[:, sv > 1e-8 * sv[0]]
+    cq = cn @ q
+    pn = cn - cq @ np.linalg.solve(q.T @ cq, cq.T)
+    pn = 0.5 * (pn + pn.T)
+    return pn * np.outer(d, d)
 
 
 def _round(obj: ConstrainedObjective, theta: np.ndarray, accurate: np.ndarray,

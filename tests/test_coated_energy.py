@@ -16,6 +16,7 @@ microfacet's physical ``ks`` range ([0, 1]: one interface with ``F <= 1``).
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 import pytest
@@ -269,3 +270,20 @@ def test_fit_with_a_non_physical_ks_range_says_so():
     (chan,) = plain.to_dict()["channels"]
     assert chan["non_physical_range"] == {} and "NON-PHYSICAL" not in plain.report()
     assert chan["bounds"]["ks"] == [0.0, 1.0]
+
+
+def test_legacy_note_is_one_warning_line_at_the_command_line(legacy_fit_dir, tmp_path):
+    # the console script prints Python warnings in the command line's form: one line
+    # "warning: ...", no source file and line (those come back with --debug)
+    import subprocess
+    import sys
+
+    out = tmp_path / "legacy.png"
+    proc = subprocess.run([sys.executable, "-m", "roughbrdf.cli", "plot", "--fit",
+                           str(legacy_fit_dir), "--out", str(out)],
+                          capture_output=True, text=True, timeout=300,
+                          env={**os.environ, "PYTHONWARNINGS": "default"})
+    assert proc.returncode == 0, proc.stderr
+    lines = [ln for ln in proc.stderr.splitlines() if "predates" in ln]
+    assert len(lines) == 1 and lines[0].startswith("warning: "), proc.stderr
+    assert "coated.py" not in proc.stderr and "LegacyCoatedWarning" not in proc.stderr

@@ -23,7 +23,9 @@ traceback); an interrupt prints ``interrupted``.
 
 from __future__ import annotations
 
+import contextlib
 import sys
+from collections.abc import Iterator
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -119,7 +121,7 @@ def main(argv: list[str] | None = None) -> int:
 
     Run.debug = "--debug" in (sys.argv[1:] if argv is None else argv)  # until parsed
     Run.interrupt_reported = False
-    with watch():
+    with watch(), _one_line_warnings():
         try:
             code = _run(argv)  # returns with SIGINT recorded, never raised
         except KeyboardInterrupt:  # only where _run did not settle (a second Ctrl-C there)
@@ -135,6 +137,31 @@ def main(argv: list[str] | None = None) -> int:
             _ignore_sigint()
             checkpoint("main: SIGINT ignored")
         return code
+
+
+@contextlib.contextmanager
+def _one_line_warnings() -> Iterator[None]:
+    """Python warnings printed as one ``warning: ...`` line, the command line's form (not
+    Python's two lines with a source file and line); the usual form with ``--debug``. Only the
+    text is changed (``warnings.formatwarning``): a caller recording warnings (pytest,
+    ``catch_warnings(record=True)``) still gets them."""
+    import warnings
+
+    formatted = warnings.formatwarning
+
+    def one_line(message: Any, category: type[Warning], filename: str, lineno: int,
+                 line: Any = None) -> str:
+        text = " ".join(str(message).split())
+        if not category.__module__.startswith("roughbrdf"):  # whose warning it is
+            text = f"{category.__name__}: {text}"
+        return f"warning: {text}\n"
+
+    if not Run.debug:
+        warnings.formatwarning = one_line
+    try:
+        yield
+    finally:
+        warnings.formatwarning = formatted
 
 
 def _run(argv: list[str] | None) -> int:

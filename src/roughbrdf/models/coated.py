@@ -481,8 +481,8 @@ def legacy_spec(spec: dict[str, Any]) -> dict[str, Any]:
     import warnings
 
     out, old = _legacy_entry(spec)
-    if old:
+    if old:  # stacklevel 1: one place, so Python shows the note once per run (not per caller)
         warnings.warn("the fit predates energy-conserving coated lobes (free lobe scales ks): "
                       "rebuilt with weights='free', which is not energy-conserving; refit for "
-                      "lobe weights that sum to 1", LegacyCoatedWarning, stacklevel=3)
+                      "lobe weights that sum to 1", LegacyCoatedWarning, stacklevel=1)
     return out

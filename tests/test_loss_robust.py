@@ -122,7 +122,8 @@ def test_non_positive_data_are_treated_as_by_the_log_loss():
     meas = _glinting_microfacet(1)
     meas.values[:3, 0] = [0.0, -1e-4, -2e-4]
     with pytest.raises(ArgumentError) as err:
-        rb.fit("microfacet", meas, loss="robust", fix=["n", "k"], starts=1, progress=False)
+        rb.fit("microfacet", meas, loss="robust", fix=["n", "k"], starts=1, negative="keep",
+               progress=False)
     assert err.value.argument == "negative" and "3 are <= 0" in str(err.value)
     res = rb.fit("microfacet", meas, loss="robust", fix=["n", "k"], starts=1, negative="drop",
                  progress=False)

@@ -61,7 +61,8 @@ from .fresnel import fresnel_polarized_cs, fresnel_sp
 from .geometry import check_angles
 
 __all__ = ["oren_nayar_factor", "coated_diffuse", "coated_diffuse_rough", "oren_nayar",
-           "lobe_albedo", "rough_interface", "ROUGH_TABLE_SIZE", "TABLE_NODES"]
+           "lobe_albedo", "rough_interface", "ROUGH_TABLE_SIZE",
+           "TABLE_NODES", "ALBEDO_NODES_PER_DECADE", "FRESNEL_GRID_SIZE"]
 
 #: table size of Mitsuba's roughplastic (``MI_ROUGH_TRANSMITTANCE_RES``): the rough interface's
 #: transmittance at 64 equally spaced values of cos(theta), interpolated linearly
@@ -85,6 +86,9 @@ _INTERNAL, _TRANSMIT, _EXTERNAL_SEPARABLE, _EXTERNAL_CORRELATED = 0, 1, 2, 3
 #: Gauss-Legendre nodes per axis of :func:`lobe_albedo` (its integrand is smooth on the
 #: visible-normal square, 32 x 32 as for the transmittance)
 _NODES_ALBEDO = 32
+#: the grid of :func:`_albedo_smooth`: ``alpha = 10^(i/128)``, every integer ``i`` (built
+#: when first needed), and the Fresnel factor at ``cos = m/63``, m = 0..63
+ALBEDO_NODES_PER_DECADE, FRESNEL_GRID_SIZE = 128, 64
 
 
 @jit(inline=True)
@@ -250,6 +254,29 @@ def _g1(dcode, a, c, approx):
 
 
 @jit(inline=True)
+def _visible_normal(a, sx, cz, gx, gy):
+    """``(wi.m, m_z)`` of the normal of slopes ``(gx, gy)`` (roughness 1) for ``wi = (sx, 0,
+    cz)``: unstretched (``wi`` lies in the x-z plane, ``sx >= 0``: no azimuth rotation)."""
+    mx, my = -gx * a, -gy * a
+    mz = 1.0 / math.sqrt(mx * mx + my * my + 1.0)
+    mx, my = mx * mz, my * mz
+    return max(0.0, sx * mx + cz * mz), mz  # visible normals face wi; max: rounding below 0
+
+
+@jit(inline=True)
+def _reflect_g(dcode, a, approx, mode, cz, z):
+    """The shadowing factor of a reflected sample with ``z`` its direction's z: ``G1(wo)``, or
+    ``G2(wi, wo)/G1(wi)`` height-correlated (:data:`_EXTERNAL_CORRELATED`)."""
+    if mode == _EXTERNAL_CORRELATED and z > 0.0:
+        # G2/G1(wi) = co (ci + Li)/(ci co + co Li + ci Lo), L = Lambda cos; den > 0 for z > 0
+        li = dist.lambda_cos(dcode, cz, a)
+        lo = dist.lambda_cos(dcode, min(1.0, z), a)
+        return z * (cz + li) / (cz * z + z * li + cz * lo)
+    # z <= 0: reflected below the interface, lost
+    return _g1(dcode, a, z, approx) if z > 0.0 else 0.0
+
+
+@jit(inline=True)
 def _lobe_sample(dcode, a, n, approx, mode, sx, cz, gx, gy):
     """One visible-normal sample of slopes ``(gx, gy)`` (roughness 1) for ``wi = (sx, 0, cz)``:
     ``mode`` 1 (:data:`_TRANSMIT`): ``(1 - F) G1(wt)`` for light refracted into index ``n > 1``
@@ -257,33 +284,40 @@ def _lobe_sample(dcode, a, n, approx, mode, sx, cz, gx, gy):
     reflected at index ``1/n`` (``eval_reflectance``; total internal reflection included);
     2, 3 (:data:`_EXTERNAL_SEPARABLE`, :data:`_EXTERNAL_CORRELATED`): ``F G2(wi, wo)/G1(wi)``
     for light from outside reflected at index ``n`` (separable or height-correlated Smith)."""
-    # unstretch (wi lies in the x-z plane with sx >= 0: the azimuth rotation is the identity)
-    mx, my = -gx * a, -gy * a
-    mz = 1.0 / math.sqrt(mx * mx + my * my + 1.0)
-    mx, my = mx * mz, my * mz
-    c = max(0.0, sx * mx + cz * mz)  # visible normals face wi; max: rounding below 0
+    c, mz = _visible_normal(a, sx, cz, gx, gy)
     if mode == _TRANSMIT:
         rs, rp = fresnel_sp(c, n, 0.0)
         ct = math.sqrt(max(0.0, 1.0 - (1.0 - c * c) / (n * n)))
         z = mz * (c / n - ct) - cz / n  # z of wi refracted through m (Mitsuba's refract)
         # z >= 0: not below the interface, no transmission
         return (1.0 - 0.5 * (rs + rp)) * _g1(dcode, a, z, approx) if z < 0.0 else 0.0
-    z = 2.0 * c * mz - cz  # z of wi mirrored about m
     rs, rp = fresnel_sp(c, n if mode >= _EXTERNAL_SEPARABLE else 1.0 / n, 0.0)
-    if mode == _EXTERNAL_CORRELATED and z > 0.0:
-        # G2/G1(wi) = co (ci + Li)/(ci co + co Li + ci Lo), L = Lambda cos; den > 0 for z > 0
-        li = dist.lambda_cos(dcode, cz, a)
-        lo = dist.lambda_cos(dcode, min(1.0, z), a)
-        return 0.5 * (rs + rp) * z * (cz + li) / (cz * z + z * li + cz * lo)
-    # z <= 0: reflected below the interface, lost
-    return 0.5 * (rs + rp) * _g1(dcode, a, z, approx) if z > 0.0 else 0.0
+    # z of wi mirrored about m
+    return 0.5 * (rs + rp) * _reflect_g(dcode, a, approx, mode, cz, 2.0 * c * mz - cz)
+
+
+@jit(inline=True)
+def _deposit(row, c, g):
+    """Add ``g`` to ``row`` (the Fresnel grid ``c_m = m/(M - 1)``) with the cubic Lagrange
+    weights of ``c`` on its 4 nearest nodes: ``sum_m row_m F(c_m) = g F(c)`` to the cubic
+    interpolation error of the smooth ``F``."""
+    size = row.size
+    x = c * (size - 1)
+    i = min(max(int(x) - 1, 0), size - 4)  # the 4 nodes around x, inside the grid
+    t = x - i
+    row[i] += g * (-(t - 1.0) * (t - 2.0) * (t - 3.0) / 6.0)
+    row[i + 1] += g * (t * (t - 2.0) * (t - 3.0) / 2.0)
+    row[i + 2] += g * (-t * (t - 1.0) * (t - 3.0) / 2.0)
+    row[i + 3] += g * (t * (t - 1.0) * (t - 2.0) / 6.0)
 
 
 @jit
-def _lobe_albedo(dcode, a, n, approx, mode, cz, x, w, dx, dy):
+def _lobe_albedo(dcode, a, n, approx, mode, cz, x, w, dx, dy, row):
     """Mitsuba's Gauss-Legendre product rule over the visible-normal sample square for
     ``wi = (sqrt(1 - cz^2), 0, cz)``: nodes ``x`` on [0, 1], weights ``w`` of [-1, 1] (hence
-    1/4), ``(dx, dy)`` the concentric-disk points of the node pairs (GGX)."""
+    1/4), ``(dx, dy)`` the concentric-disk points of the node pairs (GGX). With a non-empty
+    ``row`` (external reflection only): each sample's weight without its Fresnel factor,
+    deposited on the Fresnel grid (:func:`_deposit`) instead of summed (returns 0)."""
     sx = math.sqrt(1.0 - cz * cz)
     ct = cz / math.sqrt(a * a * sx * sx + cz * cz)  # wi stretched by the roughness
     st = math.sqrt(max(0.0, 1.0 - ct * ct))
@@ -301,7 +335,12 @@ def _lobe_albedo(dcode, a, n, approx, mode, cz, x, w, dx, dy):
                 gx, gy = bx[m], by[j]
             else:
                 gx, gy = _ggx_slope_11(ct, st, dx[j * size + m], dy[j * size + m])
-            acc += w[j] * w[m] * _lobe_sample(dcode, a, n, approx, mode, sx, cz, gx, gy)
+            if row.size == 0:
+                acc += w[j] * w[m] * _lobe_sample(dcode, a, n, approx, mode, sx, cz, gx, gy)
+            else:
+                c, mz = _visible_normal(a, sx, cz, gx, gy)
+                g = _reflect_g(dcode, a, approx, mode, cz, 2.0 * c * mz - cz)
+                _deposit(row, c, 0.25 * w[j] * w[m] * g)
     return 0.25 * acc
 
 
@@ -309,16 +348,34 @@ def _lobe_albedo(dcode, a, n, approx, mode, cz, x, w, dx, dy):
 def _rough_tables(dcode, a, n, approx, mu, xe, we, dxe, dye, xi, wi, dxi, dyi, t, e
                   ):  # pragma: no cover - compiled
     # one table entry per iteration (64): T(mu_k) on the 32 x 32 rule, E(mu_k) on 128 x 128
+    none = np.zeros(0)  # no deposit row: the samples are summed
     for k in prange(mu.size):
-        t[k] = _lobe_albedo(dcode, a, n, approx, _TRANSMIT, mu[k], xe, we, dxe, dye)
-        e[k] = _lobe_albedo(dcode, a, n, approx, _INTERNAL, mu[k], xi, wi, dxi, dyi)
+        t[k] = _lobe_albedo(dcode, a, n, approx, _TRANSMIT, mu[k], xe, we, dxe, dye, none)
+        e[k] = _lobe_albedo(dcode, a, n, approx, _INTERNAL, mu[k], xi, wi, dxi, dyi, none)
 
 
 @driver
 def _reflect_table(dcode, a, n, mode, mu, x, w, dx, dy, e):  # pragma: no cover - compiled
     # one entry per iteration: the external reflection lobe's albedo E(mu_k)
+    none = np.zeros(0)  # no deposit row: the samples are summed
     for k in prange(mu.size):
-        e[k] = _lobe_albedo(dcode, a, n, 0, mode, mu[k], x, w, dx, dy)
+        e[k] = _lobe_albedo(dcode, a, n, 0, mode, mu[k], x, w, dx, dy, none)
+
+
+@driver
+def _reflect_weights(dcode, a, mode, mu, x, w, dx, dy, out):  # pragma: no cover - compiled
+    # one row per iteration: E(mu_k) = out[k] . F(c_m; n), the Fresnel factor left out
+    for k in prange(mu.size):
+        _lobe_albedo(dcode, a, 1.0, 0, mode, mu[k], x, w, dx, dy, out[k])
+
+
+@jit
+def _fresnel_grid(n, out):
+    # the unpolarized F(c_m; n) at c_m = m/(M - 1)
+    size = out.size
+    for m in range(size):
+        rs, rp = fresnel_sp(m / (size - 1), n, 0.0)
+        out[m] = 0.5 * (rs + rp)
 
 
 @jit
@@ -410,7 +467,7 @@ def _albedo_cached(dcode: int, mode: int, alpha: float, n: float) -> tuple[float
 
 
 def lobe_albedo(alpha: float, n: float, distribution: str = "trowbridge-reitz",
-                shadowing: str = "smith-separable") -> np.ndarray:
+                shadowing: str = "smith-separable", *, smooth: bool = False) -> np.ndarray:
     """Directional albedo of one specular lobe of a dielectric interface, at the table nodes.
 
     ``E(mu) = ∫ F(theta_d; n) D G / (4 cos theta_i cos theta_r) cos theta_r dω_r`` (the
@@ -431,6 +488,9 @@ def lobe_albedo(alpha: float, n: float, distribution: str = "trowbridge-reitz",
         ``"trowbridge-reitz"`` (GGX) or ``"beckmann"``.
     shadowing : str
         ``"smith-separable"`` or ``"smith-height-correlated"``.
+    smooth : bool
+        The rule's values interpolated on a fixed grid, smooth in ``alpha`` and ``n``
+        (``n >= 1``; what the coated model uses, :func:`_albedo_smooth`).
 
     Returns
     -------
@@ -442,7 +502,24 @@ def lobe_albedo(alpha: float, n: float, distribution: str = "trowbridge-reitz",
     >>> e = rb.diffuse.lobe_albedo(0.01, 1.5)
     >>> round(float(e[-1]), 4)            # normal incidence, nearly smooth: F(0) = 0.04
     0.04
+    >>> e = rb.diffuse.lobe_albedo(0.1, 1.5, smooth=True)    # at a node: the rule's value
+    >>> bool(abs(e - rb.diffuse.lobe_albedo(0.1, 1.5)).max() < 1e-6)
+    True
     """
+    dcode, mode = _albedo_codes(distribution, shadowing)
+    a, nn = float(alpha), float(n)
+    if not (math.isfinite(a) and a > 0.0):
+        raise ValueError(f"alpha must be finite and > 0, got {alpha!r}")
+    # smooth: n < 1 reflects totally, where F is not smooth in cos (the grid needs it smooth)
+    if not (math.isfinite(nn) and nn >= (1.0 if smooth else 0.0) and nn > 0.0):
+        raise ValueError(f"n must be finite and {'>= 1' if smooth else '> 0'}, got {n!r}")
+    if smooth:
+        return _albedo_smooth(dcode, mode, a, nn)
+    return np.array(_albedo_cached(dcode, mode, a, nn))
+
+
+def _albedo_codes(distribution: str, shadowing: str) -> tuple[int, int]:
+    """The distribution code and the :func:`_lobe_sample` mode of a lobe albedo."""
     d = dist.get(distribution)
     if d.code not in (dist.TR, dist.BECKMANN):
         raise ValueError(f"distribution must be 'trowbridge-reitz' or 'beckmann', "
@@ -451,13 +528,46 @@ def lobe_albedo(alpha: float, n: float, distribution: str = "trowbridge-reitz",
     if s not in (shd.SMITH_SEPARABLE, shd.SMITH_HEIGHT_CORRELATED):
         raise ValueError(f"shadowing must be 'smith-separable' or 'smith-height-correlated', "
                          f"got {shadowing!r}")
-    a, nn = float(alpha), float(n)
-    if not (math.isfinite(a) and a > 0.0):
-        raise ValueError(f"alpha must be finite and > 0, got {alpha!r}")
-    if not (math.isfinite(nn) and nn > 0.0):
-        raise ValueError(f"n must be finite and > 0, got {n!r}")
-    mode = _EXTERNAL_SEPARABLE if s == shd.SMITH_SEPARABLE else _EXTERNAL_CORRELATED
-    return np.array(_albedo_cached(d.code, mode, a, nn))
+    return d.code, (_EXTERNAL_SEPARABLE if s == shd.SMITH_SEPARABLE else _EXTERNAL_CORRELATED)
+
+
+@functools.lru_cache(maxsize=1024)  # one matrix (32 KB) per alpha node
+def _albedo_node(dcode: int, mode: int, i: int) -> np.ndarray:
+    """The weights ``W`` at the grid node ``alpha_i`` of :func:`_albedo_smooth`:
+    ``E(mu_k; n) = W[k] . F(c_m; n)``."""
+    w = np.zeros((ROUGH_TABLE_SIZE, FRESNEL_GRID_SIZE))
+    _reflect_weights(dcode, 10.0 ** (i / ALBEDO_NODES_PER_DECADE), mode, TABLE_NODES,
+                     *_unit_square_rule(_NODES_ALBEDO), w)
+    w.setflags(write=False)
+    return w
+
+
+def _albedo_smooth(dcode: int, mode: int, a: float, nn: float) -> np.ndarray:
+    """``lobe_albedo(..., smooth=True)``: smooth in ``alpha`` and ``n``.
+
+    ``E`` depends on ``n`` only through each sample's Fresnel factor: at each node ``alpha_i
+    = 10^(i/128)`` (every integer ``i``; built when first needed and cached, 2.5 ms GGX, 6 ms
+    Beckmann) the rule's samples without it are gathered onto the grid ``cos = m/63``
+    (cubic Lagrange weights), so that ``E(n)`` is a dot product with ``F(m/63; n)``, analytic
+    in ``n``; between the nodes a Catmull-Rom spline in ``log alpha`` (continuous first
+    derivative). A fit's finite differences (steps ~1e-8 relative) see the model's
+    derivative, which a table per rounded argument would not. Against the rule's own value
+    (1200 random points, alpha 0.005-1.5, n 1.05-2.6, each distribution and shadowing):
+    at most 7e-5 (GGX) and 1.2e-4 (Beckmann), median 3e-6; the rule's value itself moves
+    unevenly in ``alpha`` by that much, and is within ~1e-3 of the exact integral.
+    """
+    f = np.empty(FRESNEL_GRID_SIZE)
+    _fresnel_grid(nn, f)
+    x = math.log10(a) * ALBEDO_NODES_PER_DECADE
+    i = math.floor(x)
+    t = x - i
+    t2, t3 = t * t, t * t * t
+    weights = (-t3 + 2 * t2 - t, 3 * t3 - 5 * t2 + 2, -3 * t3 + 4 * t2 + t, t3 - t2)
+    out = np.zeros(ROUGH_TABLE_SIZE)
+    for p, wp in enumerate(weights):
+        if wp != 0.0:  # on a node (t = 0) the spline is that node's value (no other table)
+            out += 0.5 * wp * (_albedo_node(dcode, mode, i - 1 + p) @ f)
+    return out
 
 
 @ufunc(4)

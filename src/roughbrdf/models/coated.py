@@ -239,7 +239,8 @@ def _smooth_factors(lobes: list[tuple[float, float]], n: float, distribution: st
                     shadowing: str) -> np.ndarray:
     """The smooth interface's transmission factor ``s(mu) = min(1, (1 - E(mu))/(1 - R(mu)))``
     at :data:`~roughbrdf.diffuse.TABLE_NODES`, ``E = sum_j w_j E_j`` the lobes' albedo
-    (:func:`~roughbrdf.diffuse.lobe_albedo`), ``R`` the smooth interface's reflectance.
+    (:func:`~roughbrdf.diffuse.lobe_albedo` with ``smooth=True``), ``R`` the
+    smooth interface's reflectance.
 
     A rough lobe reflects the facet-averaged ``F(theta_d)``, which can exceed ``R(theta)``
     (by up to 0.3 %: Beckmann, ``alpha`` about 0.2); the substrate then receives at most what
@@ -247,13 +248,11 @@ def _smooth_factors(lobes: list[tuple[float, float]], n: float, distribution: st
     """
     mu = TABLE_NODES
     e = np.zeros(ROUGH_TABLE_SIZE)
-    # the tables at alpha and n to 7 significant digits: a fit's finite-difference steps
-    # (~1e-8 relative) reuse the cached table instead of building one each (2-6 ms); s moves
-    # by far less than 1e-7 over such a step
-    n7 = float(f"{n:.7g}")
+    # E interpolated smoothly between tables on a fixed (alpha, n) grid: a fit's finite
+    # differences (~1e-8 relative steps) see its derivative and reuse the cached node tables
     for w, a in lobes:
         if w > 0.0:  # a lobe of weight 0 reflects nothing (and costs no table)
-            e += w * lobe_albedo(float(f"{a:.7g}"), n7, distribution, shadowing)
+            e += w * lobe_albedo(a, n, distribution, shadowing, smooth=True)
     c = mu
     g = np.sqrt(n * n - 1.0 + c * c)
     rs = ((g - c) / (g + c)) ** 2

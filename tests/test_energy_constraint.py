@@ -161,7 +161,7 @@ def test_fit_batch_passes_the_option_on(data_file, tmp_path):
 
 def test_uncertainties_are_conditional_on_the_active_constraint(both):
     """At the constrained optimum the covariance gives the active albedo (89 deg, pinned at 1
-    by the constraint) no uncertainty: ``sqrt(g^T C g)`` below 1e-4, ``g`` its gradient."""
+    by the constraint) no uncertainty: ``sqrt(g^T C g)`` below 1e-3, ``g`` its gradient."""
     _, on = both
     c = on[0]
     assert "uncertainties conditional on it" in c.message
@@ -179,18 +179,21 @@ def test_uncertainties_are_conditional_on_the_active_constraint(both):
                     for s in (1, -1))
         g[i] = (fast_albedo(up)[k] - fast_albedo(down)[k]) / (2 * h)
     cov = np.nan_to_num(c.covar[:len(names), :len(names)])
-    assert np.abs(g).max() > 0.01 and math.sqrt(abs(g @ cov @ g)) < 1e-4, (g, cov)
+    # without the projection sqrt(g^T C g) is 28 (sum) to 870 (tr75)
+    assert np.abs(g).max() > 0.01 and math.sqrt(abs(g @ cov @ g)) < 1e-3, (g, cov)
 
 
 def test_tr75_on_the_shared_paints_keeps_albedo_below_1(paints):
-    """TR75 at the defaults on the three Mini-Diff paints: C2_Black's unconstrained fit reflects
-    1.26 at 89 deg; under the constraint no channel exceeds 1 + 1e-3 on the grid."""
+    """TR75 with TR75's loss (``relative``) on the three Mini-Diff paints: C2_Black's
+    unconstrained fit reflects 1.26 at 89 deg; under the constraint no channel exceeds
+    1 + 1e-3 on the grid."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", EnergyWarning)
-        off = rb.fit("tr75", paints["C2_Black"], progress=False, energy_constraint=False)
+        off = rb.fit("tr75", paints["C2_Black"], progress=False, energy_constraint=False,
+                     loss="relative")
     assert max(rb.albedo(c.model, THETA).max() for c in off) > 1 + ENERGY_TOLERANCE
     for name, meas in paints.items():
-        res = rb.fit("tr75", meas, progress=False)
+        res = rb.fit("tr75", meas, progress=False, loss="relative")
         for c in res:
             albedo = rb.albedo(c.model, THETA)
             assert np.all(albedo <= 1 + ENERGY_TOLERANCE), (name, c.channel, albedo.max())

@@ -320,7 +320,8 @@ def coated_numpy(ti, tr, ph, p, *, distribution="trowbridge-reitz", shadowing="s
     (1 - R(theta_r)) s(theta_i) s(theta_r) / (n^2 (1 - rho F_dr,int))``, from the library's
     public parts: ``w_j`` the lobe weights (``p["ks"...]``: the free scales of
     ``weights="free"``, ``s = 1``), ``s = min(1, (1 - sum_j w_j E_j)/(1 - R))`` the smooth
-    interface's limit (``rb.diffuse.lobe_albedo``), linear in ``cos`` between its 64 nodes."""
+    interface's limit (``rb.diffuse.lobe_albedo``, ``smooth=True``), linear in ``cos`` between
+    its 64 nodes."""
     n, rho = p["n"], p["rho"]
     ci, cr = np.cos(ti), np.cos(tr)
     th = rb.geometry.theta_h(ti, tr, ph)
@@ -344,10 +345,10 @@ def coated_numpy(ti, tr, ph, p, *, distribution="trowbridge-reitz", shadowing="s
     diff = rho / np.pi * (1 - r_i) * (1 - r_r) / (n * n * (1 - rho * fdr_int))
     if not free:
         mu = np.linspace(0.0, 1.0, 64)  # the kernel interpolates as if node 0 were at 0
-        # (the model's tables are keyed to 7 significant digits of alpha and n)
+        # (the model's albedo is the rule's, interpolated smoothly in alpha and n)
         e = sum(w * rb.diffuse.lobe_albedo(
-            float(f"{p['alpha' + ('' if j == 1 else str(j))]:.7g}"), float(f"{n:.7g}"),
-            distribution, shadowing) for j, w in enumerate(weights, 1) if w > 0)
+            p["alpha" + ("" if j == 1 else str(j))], n, distribution, shadowing, smooth=True)
+            for j, w in enumerate(weights, 1) if w > 0)
         t = 1 - rb.fresnel.reflectance(rb.diffuse.TABLE_NODES, n)
         s = np.minimum(1.0, (1 - e) / t)
         s[0] = s[1]

@@ -110,14 +110,14 @@ def test_ctrl_c_at_start_is_one_line_exit_130(data, tmp_path):
 
 @pytest.mark.parametrize(("options", "message"), [
     (["--starts", "0"], "error: --starts must be >= 1 (got 0)"),
-    (["--loss", "x"], "error: --loss: unknown value 'x' (choose from relative, log, absolute, "
-                     "robust)"),
+    (["--loss", "x"], "error: --loss: unknown value 'x' (choose from auto, relative, log, "
+                     "absolute, robust)"),
     (["--seed", "-1"], "error: --seed must be >= 0 (got -1)"),
     (["--format", "zz"], "error: --format: unknown value 'zz' (choose from astm, alta, merl, "
                          "csv, zemax)"),
     (["--relative-to", "zz"], "error: --relative-to: unknown value 'zz' (choose from brdf, "
                               "bridf)"),
-    (["--negative", "zz"], "error: --negative zz: must be 'keep', 'drop' or 'clip'"),
+    (["--negative", "zz"], "error: --negative zz: must be 'auto', 'keep', 'drop' or 'clip'"),
     (["--time-limit", "0"], "error: --time-limit must be a number of seconds > 0 (got 0)"),
 ])
 def test_bad_option_exits_2_before_any_cluster(data, tmp_path, monkeypatch, capsys, options,

@@ -98,9 +98,9 @@ def test_options_are_frozen_and_replace_makes_a_checked_copy():
 
 
 @pytest.mark.parametrize("kw, argument, text", [
-    ({"loss": "squared"}, "loss", "unknown loss 'squared'; choose one of relative, log"),
+    ({"loss": "squared"}, "loss", "unknown loss 'squared'; choose one of auto, relative, log"),
     ({"starts": 0}, "starts", "starts must be >= 1"),
-    ({"negative": "nope"}, "negative", "must be 'keep', 'drop' or 'clip'"),
+    ({"negative": "nope"}, "negative", "must be 'auto', 'keep', 'drop' or 'clip'"),
     ({"nonfinite": 1}, "nonfinite", "must be 'raise' or 'drop'"),
     ({"extrapolated": "yes"}, "extrapolated", "must be 'drop' or 'keep'"),
     ({"aperture": -0.1}, "aperture", "aperture"),
@@ -118,9 +118,10 @@ def test_a_bad_option_raises_when_the_options_are_made(kw, argument, text):
 
 def test_every_option_of_fit_is_a_field_with_the_same_default():
     fields = {f.name: f.default for f in dataclasses.fields(FitOptions)}
-    assert fields["loss"] == "relative" and fields["starts"] == 8 and fields["seed"] == 0
+    assert fields["loss"] == "auto" and fields["starts"] == 8 and fields["seed"] == 0
     assert fields["subsample"] == 1000 and fields["aperture_points"] == 19
-    assert len(fields) == 26 and fields["energy_constraint"] is True and "model" not in fields and "measurement" not in fields
+    assert len(fields) == 26 and fields["energy_constraint"] is True
+    assert "model" not in fields and "measurement" not in fields
     assert FitOptions().changed() == {} and FitOptions(fix=[]).changed() == {}
 
 
@@ -207,4 +208,4 @@ def test_each_verb_shows_every_shared_option_in_its_help(verb, own):
             assert flag in res.output, (verb, flag)
     for flag in own:
         assert flag in res.output, (verb, flag)
-    assert "[default: relative]" in res.output and "[default: 8]" in res.output
+    assert "[default: auto]" in res.output and "[default: 8]" in res.output

@@ -115,12 +115,14 @@ class Loss(StrEnum):
     With ``x`` the measured value, ``f`` the model value (floored at :meth:`floor`: ``fs``) and
     ``K`` the data scale, one residual per sample (before the weight):
 
-    * ``relative`` (default): ``(K x - f)/f``, computed ``(K x)/fs - 1``; its r.m.s. is TR75's
-      sigma (Eq. 34);
+    * ``relative``: ``(K x - f)/f``, computed ``(K x)/fs - 1``; its r.m.s. is TR75's sigma
+      (Eq. 34; the papers' loss, pinned where their sigma is reproduced);
     * ``log``: ``ln(K x) - ln f``, computed ``ln x + ln K - ln fs``;
     * ``absolute``: ``K x - f``; with ``weights="uncertainty"`` the usual chi-square;
-    * ``robust``: soft-L1 of the log residual ``r = ln(K x) - ln f`` with the scale
-      ``c =`` :data:`ROBUST_SCALE`, as the transformed residual
+    * ``robust`` (the default of :func:`roughbrdf.fit`, chosen by measurement:
+      ``docs/fitting.md``, "Choosing the loss"): soft-L1 of the log residual
+      ``r = ln(K x) - ln f`` with the scale ``c =`` :data:`ROBUST_SCALE`, as the transformed
+      residual
       ``r' = sign(r) sqrt(2 c² (sqrt(1 + r²/c²) - 1))`` (computed
       ``r sqrt(2/(1 + sqrt(1 + r²/c²)))``, exact for small ``r``), so that least squares on
       ``r'`` minimizes ``sum(w² 2c² (sqrt(1 + r²/c²) - 1))``: quadratic (``r'`` ~ ``r``) for

@@ -83,9 +83,10 @@ def check_search(starts: int, loss: str, seed: int, relative_to: str | None = No
     if starts < 1:
         raise ValueError(f"--starts must be >= 1 (got {starts})")
     try:  # the loss's own check, worded for the command line
-        Loss.parse(loss)
+        if loss != "auto":
+            Loss.parse(loss)
     except ValueError:
-        raise ValueError(f"--loss: unknown value {loss!r} (choose from "
+        raise ValueError(f"--loss: unknown value {loss!r} (choose from auto, "
                          f"{', '.join(LOSSES)})") from None
     if seed < 0:  # numpy's generators take no negative seed
         raise ValueError(f"--seed must be >= 0 (got {seed})")

@@ -53,7 +53,8 @@ BoundsOption = Annotated[list[str] | None, typer.Option(
 ChannelOption = Annotated[list[str] | None, typer.Option(
     "--channel", "-c", help="channel label or index (repeatable; default: all)")]
 LossOption = Annotated[str, typer.Option(
-    help="relative ((x-f)/f, TR75), log, absolute or robust (soft-L1 of ln x - ln f)")]
+    help="auto (robust; relative for TR75: measured best, docs/fitting.md), relative "
+         "((x-f)/f, TR75), log, absolute or robust (soft-L1 of ln x - ln f)")]
 StartsOption = Annotated[int, typer.Option(help="multistart points per channel")]
 QuantityOption = Annotated[str | None, typer.Option(
     help="input: what the file's values are, if the file does not say: brdf, brdf_cos "
@@ -67,7 +68,9 @@ RelativeToOption = Annotated[str | None, typer.Option(
 FormatOption = Annotated[str | None, typer.Option(
     "--format", help="override the format chosen from the extension")]
 NonfiniteOption = Annotated[str, typer.Option(help="non-finite values: raise or drop")]
-NegativeOption = Annotated[str, typer.Option(help="negative values: keep, drop or clip")]
+NegativeOption = Annotated[str, typer.Option(
+    help="negative values: auto (drop for the log and robust losses, else keep), keep, drop "
+         "or clip")]
 SeedOption = Annotated[int, typer.Option(help="seed of the Sobol starts and the subsample")]
 FreeScaleOption = Annotated[bool | None, typer.Option(
     "--free-scale/--no-free-scale",
@@ -96,11 +99,11 @@ TABLE: dict[str, tuple[Any, Any]] = {
     "models": (ModelsOption, None), "cv": (CvOption, True), "joint": (JointOption, False),
     "shared": (SharedOption, None), "keep_extrapolated": (KeepExtrapolatedOption, False),
     "param": (ParamOption, None), "fix": (FixOption, None), "bounds": (BoundsOption, None),
-    "channel": (ChannelOption, None), "loss": (LossOption, "relative"),
+    "channel": (ChannelOption, None), "loss": (LossOption, "auto"),
     "starts": (StartsOption, 8), "quantity": (QuantityOption, None),
     "angles_in": (AnglesInOption, None), "relative_to": (RelativeToOption, None),
     "file_format": (FormatOption, None), "nonfinite": (NonfiniteOption, "raise"),
-    "negative": (NegativeOption, "keep"), "seed": (SeedOption, 0),
+    "negative": (NegativeOption, "auto"), "seed": (SeedOption, 0),
     "free_scale": (FreeScaleOption, None), "aperture": (ApertureOption, None),
     "theta_r_max": (ThetaRMaxOption, None), "source_exclusion": (SourceExclusionOption, None),
     "plots": (PlotsOption, True), "energy_constraint": (EnergyConstraintOption, True),

@@ -4,8 +4,9 @@ other measurement channel by channel (or jointly, :mod:`~roughbrdf.fitting.joint
 What :func:`roughbrdf.fit` runs for a model that is not ``"auto"``, and what model choice
 (:mod:`~roughbrdf.fitting.compare`) runs for each candidate: :func:`fit_model`. Each channel is
 fitted on its own by default; ``scipy.optimize.least_squares`` (trust-region reflective, box
-bounds) minimizes the sum of squared residuals, one per sample: ``(K x - f)/f`` by default,
-whose r.m.s. is TR75's sigma (Eq. 34). With ``options.energy_constraint`` (the default), a
+bounds) minimizes the sum of squared residuals, one per sample: by default the soft-L1
+transform of ``ln(K x) - ln f`` (the ``robust`` loss; TR75's sigma, Eq. 34, is reported
+whatever the loss). With ``options.energy_constraint`` (the default), a
 channel whose fitted model reflects more than it receives on the grid 0, 5, ... 85, 89 deg is
 refitted from that optimum under ``albedo <= 1`` (:mod:`~roughbrdf.fitting.energy`); joint fits
 and Mueller fits are checked and warned about, not constrained (``docs/fitting.md``, "Energy

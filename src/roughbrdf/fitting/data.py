@@ -39,7 +39,8 @@ if TYPE_CHECKING:
 
 __all__ = ["Comparison", "ChannelData", "DataOptions", "EXCLUSION_REASONS", "channel_weights",
            "check_fit_domain", "check_relative_to", "check_sample_options", "excluded_text",
-           "outside_fit_domain", "input_source", "prepare_channel", "where"]
+           "NEGATIVE_RULES", "negative_rule", "outside_fit_domain", "input_source",
+           "prepare_channel", "where"]
 
 #: the reasons a sample is left out or changed, in the order reports list them
 EXCLUSION_REASONS: dict[str, str] = {
@@ -174,13 +175,35 @@ class DataOptions:
         check_sample_options(self.nonfinite, self.negative, self.extrapolated)
 
 
+#: the values of ``negative`` (``"auto"``: :func:`negative_rule`)
+NEGATIVE_RULES = ("auto", "keep", "drop", "clip")
+
+
+def negative_rule(negative: str, loss: str) -> str:
+    """The rule ``negative="auto"`` stands for with ``loss``: ``"drop"`` where the loss takes a
+    logarithm (``log``, ``robust``: non-positive values have none), else ``"keep"``; any other
+    value as given.
+
+    Examples
+    --------
+    >>> negative_rule("auto", "robust"), negative_rule("auto", "relative")
+    ('drop', 'keep')
+    >>> negative_rule("clip", "log")
+    'clip'
+    """
+    if negative != "auto":
+        return negative
+    return "drop" if Loss.parse(loss).positive_data else "keep"
+
+
 def check_sample_options(nonfinite: Any, negative: Any, extrapolated: Any) -> None:
     """``nonfinite``, ``negative`` and ``extrapolated`` of :func:`roughbrdf.fit`: one of their
     words each (:class:`~roughbrdf.errors.ArgumentError` naming the option otherwise)."""
     if not isinstance(nonfinite, str) or nonfinite not in ("raise", "drop"):
         raise ArgumentError("nonfinite", "must be 'raise' or 'drop'", value=nonfinite)
-    if not isinstance(negative, str) or negative not in ("keep", "drop", "clip"):
-        raise ArgumentError("negative", "must be 'keep', 'drop' or 'clip'", value=negative)
+    if not isinstance(negative, str) or negative not in NEGATIVE_RULES:
+        raise ArgumentError("negative", "must be 'auto', 'keep', 'drop' or 'clip'",
+                            value=negative)
     if not isinstance(extrapolated, str) or extrapolated not in ("drop", "keep"):
         raise ArgumentError("extrapolated", "must be 'drop' or 'keep'", value=extrapolated)
 
@@ -381,12 +404,14 @@ def _bad_values(x: np.ndarray, keep: np.ndarray, excluded: dict[str, int],
     neg = keep & np.isfinite(x) & ((x <= 0) if log else (x < 0))
     if not neg.any():
         return
-    if opts.negative == "keep":
+    rule = negative_rule(opts.negative, opts.loss)
+    if rule == "keep":
         if log:
-            raise ArgumentError("negative", f"{place}: the log loss needs positive values but "
+            raise ArgumentError("negative", f"{place}: the {opts.loss} loss needs positive "
+                                f"values but "
                                 f"{int(neg.sum())} are <= 0 (drop them, or clip them to the "
                                 f"smallest positive value with 'clip')", fix="drop")
-    elif opts.negative == "drop":
+    elif rule == "drop":
         keep &= ~neg
         excluded["negative"] = int(neg.sum())
     else:  # clip

@@ -4,11 +4,11 @@
 model value of the compared quantity (averaged over the instrument aperture if there is one),
 ``w`` the weight and ``K`` the data scale:
 
-* ``relative`` (default): ``w (K x - f)/f``; its r.m.s. (unweighted) is TR75's sigma, Eq. 34;
+* ``relative``: ``w (K x - f)/f``; its r.m.s. (unweighted) is TR75's sigma, Eq. 34;
 * ``log``: ``w (ln(K x) - ln f)``, symmetric in over- and under-estimates;
 * ``absolute``: ``w (K x - f)``; with ``weights="uncertainty"`` the usual chi-square;
-* ``robust``: ``w r'``, ``r'`` the soft-L1 transform of the log residual (quadratic below 0.1
-  in ln units, linear above: glints and floor noise weigh less).
+* ``robust`` (default): ``w r'``, ``r'`` the soft-L1 transform of the log residual
+  (quadratic below 0.1 in ln units, linear above: glints and floor noise weigh less).
 
 Each residual, its derivative in ``K`` and the closed-form ``K`` are the loss's
 (:class:`roughbrdf.quantity.Loss`); this module weighs them and differentiates the model.

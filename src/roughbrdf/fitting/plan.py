@@ -24,9 +24,9 @@ from ..measurement import Measurement
 from ..models import Model, Parameter
 from ..models.factory import as_model, model_label
 from ..quantity import Quantity
-from .data import ChannelData, Comparison, DataOptions, input_source, where
+from .data import ChannelData, Comparison, DataOptions, input_source, negative_rule, where
 from .objective import ObjectiveSpec
-from .options import check_scale
+from .options import check_scale, default_loss
 from .search import SearchOptions
 
 if TYPE_CHECKING:
@@ -159,7 +159,10 @@ def hold_scale_parameter(model: Model, fix: Any, bounds: Any, free_scale: bool
     bound). Not when the user fixes it or gives it bounds, nor in a sum (there ``ks`` weighs
     the lobe against the other terms). Returns the model and the ``fix`` list."""
     name = SCALE_PARAMETERS.get(model.name)
-    given = [fix] if isinstance(fix, str) else list(fix or ())
+    try:
+        given = [fix] if isinstance(fix, str) else list(fix or ())
+    except TypeError:  # not a list of names: FreeParameters.of names the error
+        return model, fix
     if not free_scale or name is None or name in given or name in (bounds or {}):
         return model, fix
     return model.with_params(**{name: 1.0}), [*given, name]
@@ -219,18 +222,20 @@ class FitPlan:
         and build the plan."""
         o = options
         ap = Aperture.parse(o.aperture, o.aperture_points)
-        opts = DataOptions(Comparison.of(measurement, o.relative_to), o.loss, o.weights,
-                           o.nonfinite, o.negative, ap, o.theta_r_max, o.source_exclusion,
+        loss = default_loss(model, o.loss)
+        negative = negative_rule(o.negative, loss)
+        opts = DataOptions(Comparison.of(measurement, o.relative_to), loss, o.weights,
+                           o.nonfinite, negative, ap, o.theta_r_max, o.source_exclusion,
                            o.extrapolated)
         search = o.search()
         k_free, k_fixed = data_scale(measurement, o.free_scale, o.scale)
         model, fix = hold_scale_parameter(model, o.fix, o.bounds, k_free)
         params = FreeParameters.of(model, fix, o.bounds)
-        spec = params.spec(model, loss=o.loss, quantity=opts.comparison.quantity,
+        spec = params.spec(model, loss=loss, quantity=opts.comparison.quantity,
                            free_scale=k_free, fixed_scale=k_fixed)
         recorded = {
             "starts": search.starts, "seed": o.seed, "subsample": o.subsample,
-            "polish": search.polish, "nonfinite": o.nonfinite, "negative": o.negative,
+            "polish": search.polish, "nonfinite": o.nonfinite, "negative": negative,
             "free_scale": k_free, "scale": o.scale,
             "aperture": None if ap is None else ap.half_angle,
             "aperture_points": None if ap is None else ap.points,

@@ -362,13 +362,17 @@ def _meas(values, **kw):
 def test_negative_values_for_the_log_loss_name_the_option():
     v = np.full(12, 0.1)
     v[2] = -0.01
-    with pytest.raises(ArgumentError) as exc:
-        rb.fit("lambertian", _meas(v, meta={"file": "x.csv"}), loss="log", progress=False)
+    with pytest.raises(ArgumentError) as exc:  # keep: asked for, and impossible
+        rb.fit("lambertian", _meas(v, meta={"file": "x.csv"}), loss="log", negative="keep",
+               progress=False)
     err = exc.value
     assert err.argument == "negative" and str(err).endswith("; pass negative='drop'")
     assert "x.csv" in str(err)
     assert err.render(CLI).endswith("; pass --negative drop") and "negative=" not in \
         err.render(CLI)
+    # the default, negative="auto": dropped and counted
+    res = rb.fit("lambertian", _meas(v), loss="log", starts=1, progress=False)
+    assert res.channels[0].excluded["negative"] == 1 and res.options["negative"] == "drop"
 
 
 def test_nonfinite_values_name_the_option():

@@ -29,10 +29,14 @@ pytest.importorskip("distributed")
 runner = CliRunner()
 _SCRIPT = os.path.join(os.path.dirname(sys.executable), "roughbrdf")
 CLI = [_SCRIPT] if os.access(_SCRIPT, os.X_OK) else [sys.executable, "-m", "roughbrdf.cli"]
-OPTS = {"starts": 2}
-#: the status of a TR75 row: TR75 has no shadowing, its unconstrained albedo exceeds 1 near
-#: grazing incidence; fitted under the energy constraint it does not: "ok"
-FITTED = "ok"
+#: energy_constraint=False: these tests are about the catalogue's mechanics, and the
+#: constrained TR75 refit of these synthetic sets ends on its finishing budget ("not
+#: converged", a limit of fitting/energy.py noted on issue 20); the constraint's own tests are
+#: tests/test_energy_constraint.py
+OPTS = {"starts": 2, "energy_constraint": False}
+#: the status of a TR75 row: TR75 has no shadowing, its albedo exceeds 1 near grazing
+#: incidence (unconstrained: the fit is written; fit-batch exits 1)
+FITTED = "gains-energy"
 
 
 def _write_synthetic(folder, n: int, seed: int = 1) -> list[str]:
@@ -115,7 +119,8 @@ def test_malformed_file_among_good_ones(files, cluster, tmp_path):
     bad = tmp_path / "bad.csv"
     bad.write_text("garbage\n1,2\n")
     got = runner.invoke(app, ["fit-batch", *files, str(bad), "-m", "tr75", "--starts", "2",
-                              "--no-plots", "-o", str(tmp_path / "cat"), "--scheduler",
+                              "--no-energy-constraint", "--no-plots", "-o",
+                              str(tmp_path / "cat"), "--scheduler",
                               cluster.scheduler_address])
     assert got.exit_code == 1, got.output
     assert f"failed: {bad}: FormatError" in got.output
@@ -129,23 +134,23 @@ def test_resume_and_overwrite_refusal(cluster, tmp_path):
     paths = _write_synthetic(tmp_path, 3, seed=7)
     out = tmp_path / "cat"
     cmd = ["fit-batch", str(tmp_path / "*.csv"), "-m", "tr75", "--starts", "2", "--no-plots",
-           "-o", str(out), "--scheduler", cluster.scheduler_address]
-    assert runner.invoke(app, cmd).exit_code == 0  # TR75 under the energy constraint: exit 0
+           "--no-energy-constraint", "-o", str(out), "--scheduler", cluster.scheduler_address]
+    assert runner.invoke(app, cmd).exit_code == 1  # TR75 gains energy: written, exit 1
     first = json.loads((out / "catalogue.json").read_text())["rows"]
     again = runner.invoke(app, cmd)  # results there: refused before any work
     assert again.exit_code == 2 and "--force" in again.output
     rb.write(rb.read(paths[2]).subset(np.arange(20)), tmp_path / "changed.tmp", format="csv")
     shutil.move(tmp_path / "changed.tmp", paths[2])  # the third file changes
     got = runner.invoke(app, [*cmd, "--resume"])
-    assert got.exit_code == 0, got.output
+    assert got.exit_code == 1, got.output
     rows = json.loads((out / "catalogue.json").read_text())["rows"]
     assert [r["status"] for r in rows] == ["skipped (resume)"] * 2 + [FITTED]
     assert rows[0]["params"] == first[0]["params"] and rows[2]["n_points"] == 20
     with_options = runner.invoke(app, [*cmd, "--resume", "--starts", "3"])  # options changed
-    assert with_options.exit_code == 0
+    assert with_options.exit_code == 1
     rows = json.loads((out / "catalogue.json").read_text())["rows"]
     assert [r["status"] for r in rows] == [FITTED] * 3
-    assert runner.invoke(app, [*cmd, "--force"]).exit_code == 0
+    assert runner.invoke(app, [*cmd, "--force"]).exit_code == 1
 
 
 @pytest.mark.parametrize("to", ["process", "group"])

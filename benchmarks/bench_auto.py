@@ -1,0 +1,89 @@
+"""Model choice speed: ``rb.fit("auto")`` on one Mini-Diff file, and a single ``coated`` fit.
+
+Issue 20's budget: ``--model auto`` on one Mini-Diff file (3 channels, every candidate, the
+leave-one-incidence-out score and the energy constraint included) in at most 5 s warm on an
+AVX-512 machine and 15 s on a 2-core AVX2 one; a single ``coated`` fit in 1.5 s / 4 s.
+
+Printed, warm (the compiled kernels and the lobe-albedo tables built by a first run, not
+counted), best of :data:`REPEAT`: the default ``rb.fit("auto")``, and in the same run the
+references that show what each part costs -- without the cross-validation (``cv=False``), without
+the energy constraint -- and one ``coated`` fit; with the CPU, its widest vector unit
+(``avx512f``/``avx2`` in ``/proc/cpuinfo``) and the load average before and after, since a
+loaded 2-core machine can double every figure. Needs ``../shared/data`` (or
+``ROUGHBRDF_SHARED_DATA``); prints a note and returns without it.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+
+import roughbrdf as rb
+
+HERE = Path(__file__).resolve().parent
+DATA = Path(os.environ.get("ROUGHBRDF_SHARED_DATA", HERE.parent.parent / "shared" / "data"))
+FILE = "C2_Black"
+REPEAT = 2
+
+
+def vector_width() -> str:
+    """The widest SIMD unit the CPU reports (``/proc/cpuinfo`` flags)."""
+    try:
+        flags = next(ln for ln in Path("/proc/cpuinfo").read_text().splitlines()
+                     if ln.startswith("flags")).split()
+    except (OSError, StopIteration):  # not Linux: unknown
+        return "unknown"
+    return next((f for f in ("avx512f", "avx2", "avx", "sse4_2") if f in flags), "none")
+
+
+def load() -> str:
+    """The 1-minute load average (``os.getloadavg``), or "n/a"."""
+    try:
+        return f"{os.getloadavg()[0]:.2f}"
+    except OSError:
+        return "n/a"
+
+
+def best(call: Callable[[], object]) -> float:
+    """The best wall time of :data:`REPEAT` calls (seconds)."""
+    times = []
+    for _ in range(REPEAT):
+        t0 = time.perf_counter()
+        call()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def main() -> None:
+    path = DATA / "minidiff" / f"{FILE}.astm"
+    print("\n## Model choice speed (bench_auto)")
+    if not path.is_file():
+        print(f"skipped: {path} not found (set ROUGHBRDF_SHARED_DATA)")
+        return
+    meas = rb.read(path)
+    warnings.simplefilter("ignore")  # the candidates' plausibility warnings are not timed
+    print(f"CPU vector unit: {vector_width()}; load average before: {load()}")
+    runs = {
+        "rb.fit('auto') (defaults: CV score, energy constraint)":
+            lambda: rb.fit("auto", meas, progress=False),
+        "rb.fit('auto', cv=False) (reference: no CV refits)":
+            lambda: rb.fit("auto", meas, cv=False, progress=False),
+        "rb.fit('auto', energy_constraint=False) (reference)":
+            lambda: rb.fit("auto", meas, energy_constraint=False, progress=False),
+        "rb.fit('coated') (one candidate)":
+            lambda: rb.fit("coated", meas, progress=False),
+    }
+    rb.fit("auto", meas, progress=False)  # warm: kernels compiled, tables built
+    print(f"\n{FILE} ({meas.n_samples} geometries x {len(meas.channels)} channels), best of "
+          f"{REPEAT}, warm\n")
+    print("| run | time (s) |\n|---|---|")
+    for label, call in runs.items():
+        print(f"| {label} | {best(call):.1f} |", flush=True)
+    print(f"\nload average after: {load()}")
+
+
+if __name__ == "__main__":
+    main()

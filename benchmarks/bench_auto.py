@@ -22,6 +22,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import roughbrdf as rb
+from roughbrdf.fitting.compare import fit_auto
 
 HERE = Path(__file__).resolve().parent
 DATA = Path(os.environ.get("ROUGHBRDF_SHARED_DATA", HERE.parent.parent / "shared" / "data"))
@@ -69,8 +70,8 @@ def main() -> None:
     runs = {
         "rb.fit('auto') (defaults: CV score, energy constraint)":
             lambda: rb.fit("auto", meas, progress=False),
-        "rb.fit('auto', cv=False) (reference: no CV refits)":
-            lambda: rb.fit("auto", meas, cv=False, progress=False),
+        "fit_auto(cv=False) (reference: no CV refits)":
+            lambda: fit_auto(meas, cv=False, progress=False),
         "rb.fit('auto', energy_constraint=False) (reference)":
             lambda: rb.fit("auto", meas, energy_constraint=False, progress=False),
         "rb.fit('coated') (one candidate)":

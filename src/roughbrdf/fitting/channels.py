@@ -19,7 +19,7 @@ import time
 from typing import TYPE_CHECKING, Any
 
 from ..errors import ArgumentError
-from ..models.factory import as_model, model_label
+from ..models.factory import as_model, spec_text
 from .data import ChannelData, prepare_channel
 from .energy import EnergyConstraint, conditional_covariance, constrain_channel
 from .joint import fit_joint
@@ -82,7 +82,8 @@ def fit_channels(model: Model, measurement: Measurement, options: FitOptions) ->
     check_enough_data(measurement, data, spec.n_varys)
     joint = options.joint
     runs = search.starts * (1 if joint else len(chans))
-    with progress_bar(options.progress, runs, f"fit {model_label(model)}") as bar, \
+    # the spec, options included: three coated candidates of --model auto read apart
+    with progress_bar(options.progress, runs, f"fit {spec_text(model)}") as bar, \
             single_thread_blas():
         tick = None if bar is None else (lambda: bar.update(1))
         if joint:

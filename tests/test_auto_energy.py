@@ -1,0 +1,36 @@
+"""``--model auto`` on the glossy black paint keeps its physics (issue 20's first must-show).
+
+Before the energy-conserving coated model and the energy constraint, ``rb.fit("auto")`` on
+``C2_Black.astm`` kept two Beckmann lobes with ``ks = 20`` whose albedo was 4.0-4.5 at 80 deg
+and 8.8-9.9 at 85 deg. Now no candidate's fitted model, on any channel, has an albedo above
+``1 + 1e-3`` at any incidence of the export grid (0, 5, ... 85, 89 deg; ``rb.albedo``, the
+accurate quadrature), and the kept one is the best by the leave-one-incidence-out score.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import roughbrdf as rb
+from roughbrdf.fitting.plausibility import EXPORT_INCIDENCES_DEG
+
+
+@pytest.mark.slow
+def test_auto_on_c2_black_reflects_at_most_what_it_receives(shared_data):
+    meas = rb.read(shared_data / "minidiff" / "C2_Black.astm")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", rb.fitting.EnergyWarning)  # the kept fit: none
+        res = rb.fit("auto", meas, progress=False)
+    choice = res.model_choice
+    theta = np.radians(np.asarray(EXPORT_INCIDENCES_DEG, dtype=float))
+    for cand in choice.candidates:
+        for c in cand.result.channels:
+            a = np.asarray(rb.albedo(c.model, theta))
+            assert np.all(a <= 1 + 1e-3), (cand.label, c.channel, a.max())
+    scores = [c.cv for c in choice.candidates]
+    assert choice.criterion == "cv" and all(math.isfinite(s) for s in scores)
+    assert scores == sorted(scores) and res is choice.best.result

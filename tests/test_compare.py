@@ -329,3 +329,21 @@ def test_a_lobe_below_1e_3_is_switched_off_and_not_counted(w2, off):
     used = rb.fit(rb.model("coated", lobes=2, w2=0.3), meas, fix=["w2"], starts=1,
                   progress=False)
     assert lobes_off(used) == [] and information(used)[0] == used.channels[0].n_varys
+
+
+def test_candidates_of_different_losses_are_scored_on_one_yardstick():
+    # loss="auto": coated is fitted with robust, TR75 with relative; their loss residuals are in
+    # different units, so the score is the r.m.s. of ln(data/model) of the left-out samples
+    meas = _measurement()
+    cmp = rb.compare(meas, ["trowbridge-reitz-1975", "coated"], starts=1)
+    losses = {c.label: c.result.loss for c in cmp.candidates}
+    assert losses == {"trowbridge-reitz-1975": "relative", "coated": "robust"}
+    assert any("fitted with different losses (relative, robust)" in n for n in cmp.notes)
+    for c in cmp.candidates:
+        assert c.cv == pytest.approx(cross_validate(c.result, {"starts": 1}, metric="log"),
+                                     rel=1e-9)
+    # one loss for all: each candidate's own loss residual, as before
+    same = rb.compare(meas, ["lambertian", "coated"], starts=1, cv=True)
+    assert not any("different losses" in n for n in same.notes)
+    assert same.best.cv == pytest.approx(cross_validate(same.best.result, {"starts": 1}),
+                                         rel=1e-9)

@@ -55,7 +55,7 @@ from ..models import Model, from_spec, spec_text
 from ..models.factory import split_specs
 from ..quantity import Loss
 from .channels import fit_model
-from .options import FitOptions
+from .options import FitOptions, default_loss
 from .plausibility import ENERGY_TOLERANCE, EnergyWarning, warn_energy
 from .search import progress_bar
 
@@ -299,10 +299,12 @@ def band_rms_log(result: FitResult) -> dict[str, float]:
 
 
 def cross_validate(result: FitResult, options: FitOptions | Mapping[str, Any], *,
-                   label: str | None = None) -> float:
+                   label: str | None = None, metric: str | None = None) -> float:
     """Leave-one-incidence-out score of a fit made with ``options`` (a
     :class:`~roughbrdf.fitting.options.FitOptions` or its fields by name; module notes); NaN
-    with a single incidence. A progress bar (``options.progress``) names the candidate
+    with a single incidence. The held-out residuals are the fit's loss's, or with
+    ``metric="log"`` ``ln(K x) - ln f`` (one yardstick for candidates fitted with different
+    losses, :func:`compare`). A progress bar (``options.progress``) names the candidate
     (``label``, default the fit's model), the fold's incidence and the channel."""
     if not isinstance(options, FitOptions):
         options = FitOptions.of(None, options, caller="cross_validate")
@@ -320,17 +322,19 @@ def cross_validate(result: FitResult, options: FitOptions | Mapping[str, Any], *
         for g in angles:
             out = np.abs(meas.theta_i - g) < 1e-6
             held += _fold(result, options, meas.subset(~out), out, groups, bar,
-                          f"theta_i {math.degrees(g):g} deg")
+                          f"theta_i {math.degrees(g):g} deg", metric)
     r = np.concatenate(held) if held else np.array([])
     r = r[np.isfinite(r)]
     return float(np.sqrt(np.mean(r * r))) if r.size else math.nan
 
 
 def _fold(result: FitResult, options: FitOptions, train: Measurement, out: np.ndarray,
-          groups: list[list[Any]], bar: Any, where: str) -> list[np.ndarray]:
+          groups: list[list[Any]], bar: Any, where: str, metric: str | None = None
+          ) -> list[np.ndarray]:
     """The left-out residuals of one incidence's fold (``out``: its samples), each channel
     group refitted on ``train`` from the full fit's optimum."""
-    meas, loss = result.measurement, Loss.parse(result.loss)
+    meas = result.measurement
+    loss = Loss.LOG if metric == "log" else Loss.parse(result.loss)
     joint = bool(result.options.get("joint"))
     # an array of weights, one per sample: the training samples'
     weights = _subset_weights(options.weights, meas.n_samples, ~out)
@@ -433,6 +437,10 @@ def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | 
         keywords = {"progress": False, **keywords}
     options = FitOptions.of(options, keywords, caller="compare")
     models = _as_candidates(candidates)
+    # candidates fitted with different losses (loss="auto": robust, relative for TR75 ...)
+    # have scores in different units: they are scored on one yardstick, the log residual
+    losses = {default_loss(m, options.loss) for m in models}
+    metric = "log" if len(losses) > 1 else None
     rows: list[Candidate] = []
     for m in models:
         res = fit_model(m, measurement, options)
@@ -441,8 +449,15 @@ def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | 
             spec_text(m), res, k, n, aic, bic,
             float(np.median([c.sigma for c in res.channels])),
             float(np.median([c.rms_log for c in res.channels])), band_rms_log(res),
-            cross_validate(res, options, label=spec_text(m)) if cv else None, res.elapsed))
+            cross_validate(res, options, label=spec_text(m), metric=metric) if cv else None,
+            res.elapsed))
     rows, criterion = rank(rows)
+    if metric == "log":
+        notes_metric = ["the candidates were fitted with different losses "
+                        f"({', '.join(sorted(losses))}): CV is the r.m.s. of ln(data/model) of "
+                        "the left-out samples for all"]
+    else:
+        notes_metric = []
     notes = ["BIC and AIC assume independent residuals; neighbouring samples share the "
              "models' systematic misfit, so differences of this size overstate the evidence. "
              "CV: r.m.s. loss residual of each incidence predicted by a fit without it "
@@ -455,7 +470,7 @@ def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | 
                  "(0-85 deg; > 1 gains energy); peak ratio: model/data maximum of the "
                  "incidence where it is farthest from 1; search limit: parameters that ended "
                  "on a search bound that is no physical limit (not a result)")
-    return ModelComparison(rows, measurement, notes, criterion)
+    return ModelComparison(rows, measurement, notes + notes_metric, criterion)
 
 
 def rank(rows: Sequence[Candidate]) -> tuple[list[Candidate], str]:

@@ -15,9 +15,9 @@ from .broadcast import (
                         run_driver,
 )
 from .cache import locator_installed
-from .compile import DISABLE_JIT, at, driver, jit, ufunc
+from .compile import DISABLE_JIT, at, driver, jit, tuple_slice, ufunc
 from .vmath import SINCOS_MAX_ARG, TINY, sincos
 
 __all__ = ["DISABLE_JIT", "SINCOS_MAX_ARG", "TINY", "as_float_array", "at", "broadcast_array",
            "broadcast_dense", "broadcast_strided", "driver", "evaluate", "jit",
-           "locator_installed", "run_driver", "sincos", "ufunc"]
+           "locator_installed", "run_driver", "sincos", "tuple_slice", "ufunc"]

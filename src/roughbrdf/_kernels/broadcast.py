@@ -12,12 +12,14 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+import numba
 import numpy as np
 
 from ..interrupts import held_interrupts
+from .compile import DISABLE_JIT
 
 __all__ = ["as_float_array", "broadcast_array", "broadcast_dense", "broadcast_strided", "evaluate",
-           "run_driver"]
+           "run_driver", "SERIAL_BELOW"]
 
 
 def as_float_array(x: Any, name: str) -> np.ndarray:
@@ -59,16 +61,38 @@ def broadcast_strided(arr: np.ndarray, shape: tuple[int, ...]) -> tuple[np.ndarr
 _LOADED: set[tuple[Any, tuple[bool, ...]]] = set()
 
 
+#: below this many samples a driver runs on one thread: starting the parallel region costs
+#: about 50 us a call (measured: TR75 on 1,000 samples 73 us on two threads, 28 us on one; on
+#: 3,000 samples 83 us and 38 us), more than the work of a few thousand samples; a fit's
+#: searches evaluate 1,000-sample subsamples thousands of times
+SERIAL_BELOW = 2048
+
+
+def _call(drive: Callable, args: tuple) -> None:
+    """``drive(*args)``, on one thread when the output (the last argument) is small."""
+    out = args[-1]
+    if DISABLE_JIT or out.shape[0] >= SERIAL_BELOW:
+        drive(*args)
+        return
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)  # this thread's setting only (~1 us); restored below
+    try:
+        drive(*args)
+    finally:
+        numba.set_num_threads(threads)
+
+
 def run_driver(drive: Callable, *args: Any) -> None:
     """Call a compiled driver; the first call of each variant (the float/array layout of its
     arguments) runs with Ctrl-C held, since loading or compiling it would swallow the interrupt
-    (:mod:`roughbrdf.interrupts`). Later calls skip the hold (it costs ~7 us a call)."""
+    (:mod:`roughbrdf.interrupts`). Later calls skip the hold (it costs ~7 us a call). Fewer
+    than :data:`SERIAL_BELOW` samples run on one thread."""
     key = (drive, tuple(type(a) is float for a in args))
     if key in _LOADED:
-        drive(*args)
+        _call(drive, args)
         return
     with held_interrupts():
-        drive(*args)
+        _call(drive, args)
     _LOADED.add(key)
 
 

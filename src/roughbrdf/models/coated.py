@@ -42,7 +42,7 @@ from numba import prange
 
 from .. import distributions as dist
 from .. import shadowing as shd
-from .._kernels import at, driver, jit, sincos
+from .._kernels import at, driver, jit, sincos, tuple_slice
 from ..diffuse import (
     ROUGH_TABLE_SIZE,
     TABLE_NODES,
@@ -85,13 +85,15 @@ def _lobe(dcode, scode, a, ks, norm, hz, ci, cr):
 
 
 @jit(inline=True)
-def _on_albedo(c, s, sigma2):
+def _on_albedo(t, c, s, sigma2):
     """``max(1, albedo(theta)/rho)`` of Oren-Nayar's Eq. 30 (``docs/models.md`` §10.2:
     ``A + (2B/pi) [sin t (t/2 - sin 2t/4) + tan t (1 - sin^3 t)/3]``), which exceeds 1 by up to
-    1.5 % beyond 60.7 deg: the coated substrate's Eq. 30 factor is divided by it."""
+    1.5 % beyond 60.7 deg: the coated substrate's Eq. 30 factor is divided by it.
+
+    ``t`` is the angle itself (``c``, ``s`` its cosine and sine): no ``atan2``, a libm call
+    that would keep the drivers' loops from vectorizing."""
     a = 1.0 - 0.5 * sigma2 / (sigma2 + 0.33)
     b = 0.45 * sigma2 / (sigma2 + 0.09)
-    t = math.atan2(s, c)
     # tan t (1 - sin^3 t) -> 0 at grazing (c = 0): the stand-in 1 keeps the division finite
     tail = s * (1.0 - s * s * s) / (c if c > 0.0 else 1.0) if c > 0.0 else 0.0
     v = a + 2.0 * b / math.pi * (s * (0.5 * t - 0.5 * s * c) + tail / 3.0)
@@ -99,9 +101,9 @@ def _on_albedo(c, s, sigma2):
 
 
 @jit(inline=True)
-def _coated_terms(ti, tr, phi, gamma, p, dcode, rough):
+def _coated_terms(ti, tr, phi, gamma, p, tab, dcode, rough):
     """``(F, sum_j ks_j D_j G_j/(cos theta_i cos theta_r), substrate term, cos theta_i,
-    cos theta_r)``."""
+    cos theta_r)``; ``tab`` the interface's table (``p[_TABLE0:]`` as an array)."""
     n, rho, sigma2, scode, dmode, dshadow, fdr_int = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
     scode = int(scode)
     hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
@@ -111,25 +113,25 @@ def _coated_terms(ti, tr, phi, gamma, p, dcode, rough):
     spec += _lobe(dcode, scode, p[10], p[11], p[12], hz, ci, cr)
     spec += _lobe(dcode, scode, p[13], p[14], p[15], hz, ci, cr)
     if rough:  # a literal in each driver loop: the other interface's code compiles away
-        diff = coated_diffuse_rough(ci, cr, n, rho, p[18], p, _TABLE0)
+        diff = coated_diffuse_rough(ci, cr, n, rho, p[18], tab, 0)
     else:
         # the smooth interface's factor table (1 where the lobes reflect at most R(theta);
         # _smooth_factors): what the lobes do not reflect is all the substrate can receive
         diff = coated_diffuse(ci, cr, n, gamma, rho, fdr_int) * table_lerp(
-            ci, p, _TABLE0) * table_lerp(cr, p, _TABLE0)
+            ci, tab, 0) * table_lerp(cr, tab, 0)
     if dmode > 0.0:
         sr, cp = sincos(tr)[0], sincos(phi)[1]
         diff *= oren_nayar_factor(ci, cr, si, sr, cp, sigma2)
         if dmode > 1.5:  # Eq. 30 limited to what it receives (weights="partition")
-            diff /= max(_on_albedo(ci, si, sigma2), _on_albedo(cr, sr, sigma2))
+            diff /= max(_on_albedo(ti, ci, si, sigma2), _on_albedo(tr, cr, sr, sigma2))
     if dshadow > 0.0:
         diff *= ci * cr * shd.smith_g_over_cos_cos(scode, dcode, p[7], ci, cr)
     return f, spec, diff, ci, cr
 
 
 @jit(inline=True)
-def _coated_eval(ti, tr, phi, gamma, p, flag, dcode, rough):
-    f, spec, diff, ci, cr = _coated_terms(ti, tr, phi, gamma, p, dcode, rough)
+def _coated_eval(ti, tr, phi, gamma, p, tab, flag, dcode, rough):
+    f, spec, diff, ci, cr = _coated_terms(ti, tr, phi, gamma, p, tab, dcode, rough)
     value = 0.25 * f * spec + diff
     return value * cr if flag else value
 
@@ -161,22 +163,23 @@ def _coated_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
     # (Trowbridge-Reitz/GGX or Beckmann: the two with a Smith Lambda) and the interface
     # literals in each loop, so that the smooth loops stay free of the table look-up
     rough = p[_INTERFACE] > 0.0
+    tab = tuple_slice(p, _TABLE0, len(p))
     if int(p[16]) == dist.TR:
         if rough:
             for i in prange(out.size):
-                out[i] = _coated_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, flag, dist.TR,
-                                      True)
+                out[i] = _coated_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, tab, flag,
+                                      dist.TR, True)
         else:
             for i in prange(out.size):
-                out[i] = _coated_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, flag, dist.TR,
-                                      False)
+                out[i] = _coated_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, tab, flag,
+                                      dist.TR, False)
     elif rough:
         for i in prange(out.size):
-            out[i] = _coated_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, flag,
+            out[i] = _coated_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, tab, flag,
                                   dist.BECKMANN, True)
     else:
         for i in prange(out.size):
-            out[i] = _coated_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, flag,
+            out[i] = _coated_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, tab, flag,
                                   dist.BECKMANN, False)
 
 
@@ -189,9 +192,10 @@ def _coated_mueller_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compi
     nan = math.nan
     dcode = int(p[16])
     rough = p[_INTERFACE] > 0.0
+    tab = tuple_slice(p, _TABLE0, len(p))
     for i in prange(out.shape[0]):
         ti, tr, ph = at(a, i), at(b, i), at(c, i)
-        f, spec, diff, ci, cr = _coated_terms(ti, tr, ph, nan, p, dcode, rough)
+        f, spec, diff, ci, cr = _coated_terms(ti, tr, ph, nan, p, tab, dcode, rough)
         facet_mueller(out, i, ti, tr, ph, p[0], 0.0, flag, 0.25 * spec)
         if rough:
             out[i, 0, 0] += diff

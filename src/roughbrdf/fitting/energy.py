@@ -45,9 +45,10 @@ import numpy as np
 
 from ..models.base import PreparedGeometry
 from ..polarization import Polarization
+from .constrained import Limits, constrained_lm, finite_limits
 from .objective import BAD_RESIDUAL, EPS_STEP, Objective, ObjectiveSpec
 from .plausibility import ENERGY_TOLERANCE, EXPORT_INCIDENCES_DEG, albedo_by_incidence
-from .search import SearchOutcome, polish_fit
+from .search import POLISH_TOL, SearchOutcome, polish_fit
 from .statistics import Covariance
 
 if TYPE_CHECKING:
@@ -89,8 +90,14 @@ ROUND_SAMPLES = 1000
 #: residual evaluations of one round at most (each costs a Jacobian too: one fast albedo per
 #: free parameter; 10 per parameter made a 14-parameter RB08 refit 20-45 s per C2_Black channel)
 ROUND_NFEV = 30
-#: residual evaluations of the polish on all samples at most
-FINISH_NFEV = 100
+#: constrained refits on all samples at most (the fast albedo's defect correction renewed at
+#: each one's start; one suffices but for lobes the fast albedo resolves poorly)
+FINISH_PASSES = 3
+#: residual evaluations of one of them at most, per free parameter (``least_squares``' own)
+PASS_NFEV = 100
+#: an incidence is active when its albedo is within this of the target (the solver meets the
+#: corrected fast albedo's target to ~1e-7; the accurate albedo differs from it by ~1e-4)
+ACTIVE_SLACK = 2e-4
 #: (largest incidence in degrees, n_psi) of the fast quadrature: more azimuths near grazing,
 #: where the lobe is squeezed against the horizon
 N_PSI: tuple[tuple[float, int], ...] = ((60.0, 32), (75.0, 64), (90.0, 192))
@@ -232,6 +239,51 @@ class ConstrainedObjective(Objective):
                 t[j] += h
                 rows[acting, j] = (self.penalty(t, where) - p0[acting]) / h
         return np.vstack([super().jac(theta, k), rows])
+
+
+@dataclass(eq=False)
+class AlbedoLimits:
+    """The constraint ``A_k(theta) + bias_k - target <= 0`` at the watched incidences of the
+    grid, as :class:`~roughbrdf.fitting.constrained.Limits` for
+    :func:`~roughbrdf.fitting.constrained.constrained_lm`.
+
+    ``A`` is :func:`fast_albedo`; ``bias`` its defect correction (accurate - fast at the
+    pass's start point); the Jacobian is forward differences (one fast albedo per parameter).
+    """
+
+    spec: ObjectiveSpec
+    bias: np.ndarray
+    #: positions (in the grid) of the incidences watched: the others are far below 1
+    watch: np.ndarray
+    target: float = 1.0 - 5e-4
+    albedo_evals: int = 0
+
+    def albedo(self, theta: np.ndarray) -> np.ndarray:
+        """The corrected fast albedo at ``theta`` at the watched incidences."""
+        self.albedo_evals += 1
+        degs = tuple(float(EXPORT_INCIDENCES_DEG[k]) for k in self.watch)
+        return fast_albedo(self.spec.model_at(theta), degs) + self.bias[self.watch]
+
+    def values(self, theta: np.ndarray) -> np.ndarray:
+        """``g(theta)``: the albedo's excess over the target (non-finite for a model that
+        overflows; the solver counts it as violated)."""
+        return self.albedo(np.asarray(theta, dtype=float)) - self.target
+
+    def jac(self, theta: np.ndarray, g: np.ndarray) -> np.ndarray:
+        """Forward differences of :meth:`values` (``g`` its values at ``theta``)."""
+        theta = np.asarray(theta, dtype=float)
+        rows = np.zeros((self.watch.size, theta.size))
+        g0 = finite_limits(g)
+        for j in range(theta.size):
+            t = theta.copy()
+            h = _step(self.spec, theta, j)
+            t[j] += h
+            rows[:, j] = (finite_limits(self.values(t)) - g0) / h
+        return rows
+
+    def limits(self) -> Limits:
+        """The solver's view."""
+        return Limits(self.values, self.jac)
 
 
 def _step(spec: ObjectiveSpec, theta: np.ndarray, j: int, rel: float = EPS_STEP) -> float:
@@ -421,28 +473,37 @@ def _run_rounds(obj: ConstrainedObjective, theta: np.ndarray, accurate: np.ndarr
 
 
 def _finish(spec: ObjectiveSpec, data: ChannelData, state: _Rounds, max_nfev: int | None,
-            tried: list[dict[str, Any]]) -> ConstrainedObjective:
-    """The polish of the best round's point on all samples of ``data``, with that round's
-    penalty (scaled from the subsample's cost to the full one); kept when it satisfies the
-    constraint (``state`` updated), else the round's point stands. Returns the objective."""
+            tried: list[dict[str, Any]]) -> int:
+    """The refit of the best round's point on all samples of ``data`` under the constraint
+    itself (:func:`~roughbrdf.fitting.constrained.constrained_lm`, the fast albedo corrected
+    at each pass's start), to convergence; a pass that ends with the accurate albedo above the
+    tolerance is followed by another from its end (at most :data:`FINISH_PASSES`). Kept when
+    it satisfies the constraint, or lowers the albedo of rounds that did not (``state``
+    updated); else the round's point stands. Returns the residual evaluations it made."""
     assert state.theta is not None and state.accurate is not None  # one round ran
-    full = ConstrainedObjective(spec, data, target=1.0 - MARGIN)
-    cost_full = max(full.cost(state.theta), COST_FLOOR ** 2 * data.n)
-    full.weight = math.sqrt(state.lam * cost_full)
-    if not state.ok or data.n == 0:  # nothing to finish: the rounds did not get there
-        return full
-    full.bias = state.accurate - fast_albedo(full.model_at(state.theta))
-    full.watch = np.flatnonzero(~(state.accurate < WATCH))
-    budget = FINISH_NFEV if max_nfev is None else min(max_nfev, FINISH_NFEV)
-    res = polish_fit(full, state.theta, budget)
-    after = checked_albedo(full.model_at(res.x))
-    if not np.nanmax(after) > 1 + ENERGY_TOLERANCE:  # else the round's point stands
-        x = np.asarray(res.x, dtype=float)
-        tried.append({"x0": state.theta.tolist(), "x": x.tolist(), "stage": "energy",
-                      "cost": 0.5 * float(np.sum(Objective.fun(full, x) ** 2)),
-                      "origin": "energy polish"})
-        state.theta, state.result, state.accurate = x, res, after
-    return full
+    if data.n == 0:
+        return 0
+    nfev = 0
+    obj = Objective(spec, data)
+    budget = PASS_NFEV * state.theta.size if max_nfev is None else max_nfev
+    theta, accurate = state.theta, state.accurate
+    for k in range(1, FINISH_PASSES + 1):
+        limits = AlbedoLimits(spec, accurate - fast_albedo(spec.model_at(theta)),
+                              np.flatnonzero(~(accurate < WATCH)), 1.0 - MARGIN)
+        res = constrained_lm(obj, limits.limits(), theta, POLISH_TOL, budget)
+        nfev += res.nfev
+        theta = np.asarray(res.x, dtype=float)
+        accurate = checked_albedo(spec.model_at(theta))
+        tried.append({"x0": tried[-1]["x"], "x": theta.tolist(), "stage": "energy",
+                      "cost": float(res.cost), "origin": f"energy finish {k}"})
+        state.count += 1
+        ok = not np.nanmax(accurate) > 1 + ENERGY_TOLERANCE
+        if ok or (not state.ok and np.nanmax(accurate) < np.nanmax(state.accurate)):
+            state.theta, state.result, state.accurate = theta, res, accurate
+            state.ok = ok
+        if ok:
+            break
+    return nfev
 
 
 def constrain_channel(spec: ObjectiveSpec, data: ChannelData, outcome: SearchOutcome,
@@ -467,14 +528,15 @@ def constrain_channel(spec: ObjectiveSpec, data: ChannelData, outcome: SearchOut
     tried = list(outcome.tried)
     sub = ConstrainedObjective(spec, _subsample(data))
     state = _run_rounds(sub, theta, accurate, max_nfev, tried)
-    full = _finish(spec, data, state, max_nfev, tried)
+    finish_nfev = _finish(spec, data, state, max_nfev, tried)
     assert state.theta is not None and state.accurate is not None  # one round ran
-    # active: where the penalty acts at the result (the albedo at or above the target)
-    active = [k for k, a in enumerate(state.accurate) if a >= full.target]
+    # active: where the constraint holds the albedo at the target (to the accurate albedo's
+    # agreement with the corrected fast one)
+    active = [k for k, a in enumerate(state.accurate) if a >= 1.0 - MARGIN - ACTIVE_SLACK]
     info = EnergyConstraint(
         active=bool(active), theta_deg=[float(EXPORT_INCIDENCES_DEG[k]) for k in active],
         max_albedo=float(np.nanmax(state.accurate)), satisfied=state.ok,
         unconstrained_max_albedo=float(np.nanmax(accurate)), rounds=state.count,
         elapsed=time.perf_counter() - t0)
-    nfev = outcome.explore_nfev + sub.nfev + full.nfev
+    nfev = outcome.explore_nfev + sub.nfev + finish_nfev
     return SearchOutcome(state.theta, state.result, tried, nfev), info

@@ -25,8 +25,11 @@ incidence of the grid (:func:`constrain_channel`):
   :data:`~roughbrdf.fitting.plausibility.ENERGY_TOLERANCE` somewhere, ``lambda`` grows by
   :data:`GROWTH` (at most :data:`MAX_ROUNDS` rounds; then the fit says it could not, and the
   usual :class:`~roughbrdf.fitting.plausibility.EnergyWarning` follows);
-* the round that satisfies the constraint is polished on all samples under its penalty (at most
-  :data:`FINISH_NFEV` evaluations), and kept when the constraint still holds.
+* the rounds keep the refit in the unconstrained optimum's basin but do not converge on the
+  constraint (the hinge makes the cost non-smooth there); the best round's point is finished
+  on all samples under the constraint itself,
+  :func:`~roughbrdf.fitting.constrained.constrained_lm` (:func:`_finish`, at most
+  :data:`FINISH_PASSES` passes), and kept when the constraint holds.
 
 At a constrained optimum the covariance is the data's, projected on the directions along which
 the active constraints stay constant (:func:`conditional_covariance`): the uncertainties are
@@ -85,7 +88,7 @@ COST_FLOOR = 1e-2
 #: lobes narrower than a degree at grazing incidence, and the fit's plausibility check still
 #: uses the accurate albedo at every incidence and warns)
 SCREEN_MARGIN = 0.05
-#: samples of the channel the rounds fit (the best round's point is then polished on all)
+#: samples of the channel the rounds fit (the best round's point is then finished on all)
 ROUND_SAMPLES = 1000
 #: residual evaluations of one round at most (each costs a Jacobian too: one fast albedo per
 #: free parameter; 10 per parameter made a 14-parameter RB08 refit 20-45 s per C2_Black channel)
@@ -513,7 +516,7 @@ def constrain_channel(spec: ObjectiveSpec, data: ChannelData, outcome: SearchOut
     energy (module notes); ``(outcome, None)`` when it does not.
 
     The rounds run on :data:`ROUND_SAMPLES` samples of the channel; the best round's point is
-    then polished on all of them under its penalty. Returns the outcome at the constrained
+    then refitted on all of them under the constraint (:func:`_finish`). Returns the outcome at the constrained
     optimum (the refits added to ``tried`` with stage ``"energy"``) and what the constraint
     did. The round with the lowest cost among those that satisfy the constraint is kept; when
     none does, the one with the lowest albedo.

@@ -29,10 +29,10 @@ pytest.importorskip("distributed")
 runner = CliRunner()
 _SCRIPT = os.path.join(os.path.dirname(sys.executable), "roughbrdf")
 CLI = [_SCRIPT] if os.access(_SCRIPT, os.X_OK) else [sys.executable, "-m", "roughbrdf.cli"]
-#: energy_constraint=False: these tests are about the catalogue's mechanics, and the
-#: constrained TR75 refit of these synthetic sets ends on its finishing budget ("not
-#: converged", a limit of fitting/energy.py noted on issue 20); the constraint's own tests are
-#: tests/test_energy_constraint.py
+#: energy_constraint=False: these tests are about the catalogue's mechanics, and with it off
+#: every row takes the not-ok path (status "gains-energy", exit 1) through the runners. The
+#: constrained refit of these same synthetic sets is tested in tests/test_constrained.py (it
+#: converges, with the albedo <= 1), the constraint's CLI in tests/test_energy_constraint.py
 OPTS = {"starts": 2, "energy_constraint": False}
 #: the status of a TR75 row: TR75 has no shadowing, its albedo exceeds 1 near grazing
 #: incidence (unconstrained: the fit is written; fit-batch exits 1)

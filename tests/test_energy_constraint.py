@@ -197,3 +197,26 @@ def test_tr75_on_the_shared_paints_keeps_albedo_below_1(paints):
         for c in res:
             albedo = rb.albedo(c.model, THETA)
             assert np.all(albedo <= 1 + ENERGY_TOLERANCE), (name, c.channel, albedo.max())
+
+
+@pytest.mark.parametrize(("spec", "expected"), [
+    ("coated", True), ("coated(lobes=3, diffuse=oren-nayar)", True),
+    ("coated(weights=free)", False), ("lambertian", True), ("tr75", False),
+    ("microfacet", False), ("rb08", False)])
+def test_conserves_energy_says_what_the_construction_guarantees(spec, expected):
+    # True only where docs/models.md §10.4 proves it (coated: tests/test_coated_energy.py's
+    # Hypothesis test over the whole domain; Lambertian: albedo = rho <= 1); a sum never
+    assert rb.model(spec).conserves_energy is expected
+    assert (rb.model(spec) + rb.model("lambertian")).conserves_energy is False
+
+
+def test_a_model_that_conserves_energy_by_construction_skips_the_check(monkeypatch):
+    import roughbrdf.fitting.energy as energy
+
+    def fail(model):
+        raise AssertionError("checked_albedo called for an energy-conserving model")
+
+    monkeypatch.setattr(energy, "checked_albedo", fail)
+    truth = rb.model("coated", alpha=0.2, rho=0.3)
+    res = rb.fit("coated", measurement(truth), starts=1, progress=False)
+    assert res[0].energy_constraint is None and not res.gains_energy

@@ -516,11 +516,13 @@ def constrain_channel(spec: ObjectiveSpec, data: ChannelData, outcome: SearchOut
     energy (module notes); ``(outcome, None)`` when it does not.
 
     The rounds run on :data:`ROUND_SAMPLES` samples of the channel; the best round's point is
-    then refitted on all of them under the constraint (:func:`_finish`). Returns the outcome at the constrained
-    optimum (the refits added to ``tried`` with stage ``"energy"``) and what the constraint
-    did. The round with the lowest cost among those that satisfy the constraint is kept; when
-    none does, the one with the lowest albedo.
+    then refitted on all of them under the constraint (:func:`_finish`). Returns the outcome
+    at the constrained optimum (the refits added to ``tried`` with stage ``"energy"``) and
+    what the constraint did. The round with the lowest cost among those that satisfy the
+    constraint is kept; when none does, the one with the lowest albedo.
     """
+    if spec.model.conserves_energy:  # by construction: nothing to check or constrain (the
+        return outcome, None         # fit's plausibility check still computes its albedo)
     t0 = time.perf_counter()
     theta = np.asarray(outcome.theta, dtype=float)
     # plausibility.energy_gain's test (every channel of every candidate and cross-validation

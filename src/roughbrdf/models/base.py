@@ -207,6 +207,13 @@ class Model:
     def param_names(self) -> list[str]:
         return [p.name for p in self._specs]
 
+    @property
+    def conserves_energy(self) -> bool:
+        """Whether every parameter value of the domain keeps the albedo at most 1 (to
+        ``1e-3``), by construction (``docs/models.md`` §10.4): the fits' energy constraint
+        then has nothing to check. False unless a model says so."""
+        return False
+
     def with_params(self, **updates: Any) -> Model:
         """A copy with some parameters (or options) changed.
 

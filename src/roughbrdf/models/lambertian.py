@@ -52,6 +52,11 @@ class Lambertian(Model):
     grazing_incidence = True
     _drive = _lambert_drive
 
+    @property
+    def conserves_energy(self) -> bool:
+        """True: the albedo is ``rho <= 1`` at every incidence."""
+        return True
+
     def _pack(self) -> tuple:
         return (self._values["rho"],)
 

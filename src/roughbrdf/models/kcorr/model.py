@@ -94,7 +94,7 @@ class KCorrelation(Model):
     >>> bool(0.0 < f < 1.0)
     True
     >>> round(m.sigma_rms() * 1e3, 3), round(m.correlation_length, 4)   # nm, µm
-    (1.596, 0.7958)
+    (1.585, 0.7958)
     """
 
     name = "k-correlation"
@@ -142,18 +142,18 @@ class KCorrelation(Model):
     def sigma_rms(self, f_min: float = 0.0, f_max: float = math.inf) -> float:
         """RMS roughness in µm over ``[f_min, f_max]`` (cycles/µm; the total by default, which
         needs ``C > 2``): :func:`roughbrdf.models.kcorr.sigma_rms`."""
-        v = self._values
+        v = self._floats()
         return psd.sigma_rms(v["A"], v["B"], v["C"], f_min, f_max)
 
     def rms_slope(self, f_min: float = 0.0, f_max: float = math.inf) -> float:
         """RMS slope over ``[f_min, f_max]`` (the total needs ``C > 4``)."""
-        v = self._values
+        v = self._floats()
         return psd.rms_slope(v["A"], v["B"], v["C"], f_min, f_max)
 
     @property
     def correlation_length(self) -> float:
         """``B / (2 pi)`` in µm."""
-        return psd.correlation_length(self._values["B"])
+        return psd.correlation_length(self._floats()["B"])
 
     def band(self, theta_i: Any, theta_r: Any, phi: Any) -> tuple[float, float]:
         """``(f_min, f_max)`` (cycles/µm) the given geometries (radians) sample at this
@@ -165,7 +165,7 @@ class KCorrelation(Model):
         """The parameters in metrology terms: ``sigma_rms`` (µm, over the band; ``None`` where
         it diverges), ``correlation_length`` (µm), ``rms_slope`` (``None`` where it diverges),
         ``C`` and the profile (1-D) PSD's ``A_1d`` (µm³, ``None`` for ``C <= 1``)."""
-        v = self._values
+        v = self._floats()
         out: dict[str, float | None] = {"correlation_length": self.correlation_length,
                                         "C": v["C"]}
         for key, fn in (("sigma_rms", self.sigma_rms), ("rms_slope", self.rms_slope)):

@@ -101,7 +101,8 @@ def sigma_rms(a: float, b: float, c: float, f_min: float = 0.0, f_max: float = m
     Examples
     --------
     >>> from roughbrdf.models.kcorr import sigma_rms
-    >>> round(sigma_rms(2 * 3.141592653589793 * 1e-6, 2 * 3.141592653589793, 3.0), 9)  # A = 2 pi s^2 l^2
+    >>> two_pi = 2 * 3.141592653589793
+    >>> round(sigma_rms(two_pi * 1e-6, two_pi, 3.0), 9)   # A = 2 pi s^2 l^2, B = 2 pi l, C = 3
     0.001
     """
     a, b, c = _abc(a, b, c)

@@ -33,10 +33,11 @@ Stover Eq. 2.8 for normal incidence), ``R`` the Fresnel reflectance of the incid
 polarization and ``sigma`` the total rms roughness. It follows from the model when all of the
 PSD lies near the specular point, where ``Q -> R`` and ``cos theta_r -> cos theta_i``: it needs
 ``C > 2`` and ``B >> lambda`` (correlation length much longer than the wavelength). Its
-relative error is about the PSD fraction beyond the horizon,
+relative error is about the PSD fraction beyond the horizon, at most
 ``(1 + (B (1 - sin theta_i)/lambda)^2)^(1 - C/2)``, plus ``O((lambda/B)^2)`` from the change of
-``Q cos theta_r`` over the PSD's width (e.g. below 1e-3 for ``C = 4``, ``B/lambda = 100``,
-``theta_i <= 60°``).
+``Q cos theta_r`` over the PSD's width (measured: 1.6e-4 up to ``theta_i = 30°`` and 1.5e-3 at
+60° for ``C = 4``, ``B/lambda = 100``; 4 % at normal incidence for ``C = 2.5``,
+``B/lambda = 572``, SCATMECH's default PSD at 0.6328 µm).
 """
 
 from __future__ import annotations

@@ -15,6 +15,7 @@ constraint").
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from typing import TYPE_CHECKING, Any
 
@@ -30,6 +31,7 @@ from .polarimetric import fit_mueller
 from .result import ChannelFit, FitResult
 from .search import MultiStart, SearchOptions, progress_bar
 from .threads import single_thread_blas
+from .wavelengths import channel_wavelength, needs_wavelength, with_wavelength
 
 if TYPE_CHECKING:
     from ..measurement import Measurement
@@ -64,10 +66,25 @@ def fit_model(model: Model | str, measurement: Measurement, options: FitOptions,
         res = fit_mueller(model, measurement, options=options)
     else:
         refuse_polarimetric_weight(options)
-        res = fit_channels(as_model(model), measurement, options)
+        m = as_model(model)
+        res = (_by_wavelength(m, measurement, options) if needs_wavelength(m)
+               else fit_channels(m, measurement, options))
     if check_energy:
         warn_energy(res, stacklevel=4)
     return res
+
+
+def _by_wavelength(model: Model, measurement: Measurement, options: FitOptions) -> FitResult:
+    """A model that needs the wavelength (:mod:`~roughbrdf.fitting.wavelengths`): each channel
+    fitted with the model at that channel's wavelength, the results in one."""
+    if options.joint:
+        raise ArgumentError("joint", "the model depends on the wavelength, which differs from "
+                            "channel to channel: fit the channels separately", value=True)
+    results = [fit_channels(with_wavelength(model, channel_wavelength(
+        measurement, j, options.wavelength)), measurement, options.replace(channel=[j]))
+        for j in channel_indices(measurement, options.channel)]
+    return dataclasses.replace(results[0], channels=[c for r in results for c in r.channels],
+                               elapsed=sum(r.elapsed for r in results))
 
 
 def fit_channels(model: Model, measurement: Measurement, options: FitOptions) -> FitResult:

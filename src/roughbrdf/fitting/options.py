@@ -33,6 +33,7 @@ from typing import Any
 
 from ..errors import ArgumentError
 from ..instrument import Aperture
+from ..models.kcorr import parse_wavelength
 from ..quantity import LOSSES, Loss
 from .data import check_fit_domain, check_sample_options
 from .search import SearchOptions
@@ -186,6 +187,11 @@ class FitOptions:
         ``albedo <= 1`` there (:mod:`~roughbrdf.fitting.energy`); models that conserve energy
         by construction never need it. ``False``: the unconstrained fit (as the papers').
         Joint and Mueller fits are checked, not constrained.
+    wavelength : float, str or None
+        For models with a ``wavelength`` option left unset (K-correlation / Rayleigh–Rice): the
+        wavelength of every channel, in µm or as a string with a unit (``"630nm"``). None
+        (default): each channel's from the file or its name (:mod:`~roughbrdf.fitting.
+        wavelengths`); a model that needs one and finds none is refused.
 
     Raises
     ------
@@ -193,7 +199,8 @@ class FitOptions:
         On construction (and by :meth:`replace`), for every option that is bad whatever the
         model and the data: the aperture and its rule, the fit domain, the loss, ``nonfinite``,
         ``negative``, ``extrapolated``, the search counts and seed, ``scale``, ``joint``,
-        ``shared`` without a joint fit, ``polarimetric_weight``, ``energy_constraint``.
+        ``shared`` without a joint fit, ``polarimetric_weight``, ``energy_constraint``,
+        ``wavelength``.
     """
 
     channel: int | str | Sequence[int | str] | None = None
@@ -222,6 +229,7 @@ class FitOptions:
     polarimetric_weight: float | None = None
     progress: bool | None = None
     energy_constraint: bool = True
+    wavelength: float | str | None = None
 
     def __post_init__(self) -> None:
         # in the order the fit met them before the options were one object
@@ -243,6 +251,7 @@ class FitOptions:
         if not isinstance(self.energy_constraint, bool):  # a string "no" would be truthy
             raise ArgumentError("energy_constraint", "must be True or False",
                                 value=self.energy_constraint)
+        parse_wavelength(self.wavelength)  # ArgumentError naming wavelength
 
     @classmethod
     def of(cls, options: FitOptions | None = None, keywords: Mapping[str, Any] | None = None,

@@ -45,6 +45,9 @@ __all__ = ["AT_BOUND_RTOL", "Covariance", "GoodnessOfFit", "at_bound", "limit_ki
 
 #: a parameter within this fraction of the width of its bounds from a bound is "at the bound"
 AT_BOUND_RTOL = 1e-6
+#: a non-zero bound below this fraction of the width marks a search over decades: "at" it
+#: means within ``AT_BOUND_RTOL`` of the bound itself
+LOG_RANGE = 1e-3
 
 
 def at_bound(theta: np.ndarray, lower: np.ndarray, upper: np.ndarray, names: Sequence[str],
@@ -52,13 +55,18 @@ def at_bound(theta: np.ndarray, lower: np.ndarray, upper: np.ndarray, names: Seq
     """``{name: "lower" | "upper"}`` for the parameters at a bound.
 
     A parameter is at a bound when it is within ``rtol`` times the width of its bounds of it
-    (``rtol`` times ``max(1, |bound|)`` when the other bound is infinite).
+    (``rtol`` times ``max(1, |bound|)`` when the other bound is infinite), or, for a bound
+    other than 0 below :data:`LOG_RANGE` times that width, within ``rtol`` times the bound:
+    a parameter searched over many decades (an ABC PSD's ``A`` in [1e-14, 1e3]) is not "at"
+    its lower bound 1e-14 when it is 2e-5.
 
     Examples
     --------
     >>> at_bound(np.array([5e-13, 0.5, 4.99999999]), np.zeros(3), np.array([10.0, 1.0, 5.0]),
     ...          ["k", "e", "n"])
     {'k': 'lower', 'n': 'upper'}
+    >>> at_bound(np.array([2e-5, 1e-14]), np.full(2, 1e-14), np.full(2, 1e3), ["A", "A2"])
+    {'A2': 'lower'}
     """
     out: dict[str, str] = {}
     for nm, t, lo, hi in zip(names, theta, lower, upper, strict=True):
@@ -66,7 +74,9 @@ def at_bound(theta: np.ndarray, lower: np.ndarray, upper: np.ndarray, names: Seq
         for side, b, dist in (("lower", lo, t - lo), ("upper", hi, hi - t)):
             if not math.isfinite(b):
                 continue
-            tol = rtol * (span if math.isfinite(span) else max(1.0, abs(b)))
+            width = span if math.isfinite(span) else max(1.0, abs(b))
+            # a bound far below the width (a search over decades): relative to the bound
+            tol = rtol * (abs(b) if 0.0 < abs(b) < LOG_RANGE * width else width)
             if dist <= tol:
                 out[nm] = side
                 break

@@ -393,6 +393,8 @@ def test_registered_names_and_round_trip():
     assert {p.name: p.unit for p in m.parameters} == {"A": "um^4", "B": "um", "C": "1",
                                                       "n": "1", "k": "1"}
     assert "SCATMECH" in m.reference
+    text = _model(A=1e-5, B=5.0, C=3.0).describe()
+    assert "sigma_rms = 0.00158533 um" in text and "rms slope = diverges (C <= 4)" in text
 
 
 def test_pure_python_mode_agrees():

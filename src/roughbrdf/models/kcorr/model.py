@@ -65,7 +65,8 @@ def parse_wavelength(value: Any) -> float | None:
         raise ArgumentError("wavelength", f"is in micrometres and must be at most "
                             f"{MAX_WAVELENGTH_UM:g} µm; a value in nm? (630 nm is 0.63, or "
                             f"give '630nm')", value=value)
-    return round(lam, 12)  # "630nm" * 1e-3 -> 0.63 exactly as written, not 0.63000000000000001
+    # 12 significant digits: "630nm" * 1e-3 gives 0.63 as written, not 0.6300000000000001
+    return float(f"{lam:.12g}")
 
 
 @register
@@ -175,3 +176,17 @@ class KCorrelation(Model):
                 out[key] = None
         out["A_1d"] = psd.abc_1d_from_2d(v["A"], v["B"], v["C"])[0] if v["C"] > 1 else None
         return out
+
+    def describe(self) -> str:
+        """The base description plus the parameters in metrology terms (total band)."""
+        met = self.metrology()
+
+        def show(key: str, unit: str, why: str) -> str:
+            v = met[key]
+            return f"{v:.6g} {unit} (total)" if v is not None else f"diverges ({why})"
+
+        return "\n".join([
+            super().describe(),
+            f"  metrology: sigma_rms = {show('sigma_rms', 'um', 'C <= 2')}, "
+            f"correlation length = {met['correlation_length']:.6g} um (B/2pi), "
+            f"rms slope = {show('rms_slope', 'rad', 'C <= 4')}"])

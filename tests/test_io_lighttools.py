@@ -182,6 +182,16 @@ def test_handwritten_file_crlf_comments_btdf_and_back_side():
     assert "Source Measured" in " ".join(m.meta["quirks"])
 
 
+@pytest.mark.parametrize("path", [HAND, XYZ, ASYM, PLANE], ids=lambda p: p.name)
+def test_geometry_is_in_the_common_frame(path):
+    m = read(path)
+    assert (m.theta_i >= 0).all() and (m.theta_i <= math.pi / 2).all()
+    assert (m.theta_r >= 0).all() and (m.theta_r <= math.pi / 2).all()
+    assert (m.phi > -math.pi - 1e-12).all() and (m.phi <= math.pi + 1e-12).all()
+    assert all(r["nonfinite"] == 0 and r["negative"] == 0 for r in m.validate().values())
+    assert m.meta["format"] == "lighttools" and m.meta["file_abs"] == str(path.resolve())
+
+
 def test_side_back_reads_the_back_blocks():
     m = read(HAND, side="back")
     o = m.original
@@ -240,6 +250,8 @@ def test_aoi_180_is_normal_incidence_as_libbsdf_reads_it(tmp_path):
     (BLOCK, "Symmetry Asymmetric\nScatterAzimuth 2\n0 400\nScatterRadial 2\n0 90\n",
      r"ScatterAzimuth: angles must lie in \[0, 360\]"),
     ("AOI 0\nTIS 0.3\n0.1 0.1\n0.1 oops\n", None, r"line 11: expected value 4 of 4"),
+    ("AOI 0\nTIS 0.3\n0.1 nan\n0.1 0.1\n", None, r"line 10: expected value 2 of 4.*'nan'"),
+    ("AOI 0\nTIS 0.3\n0.1 0.1 1_0\n", None, r"line 10: expected value 3 of 4.*'1_0'"),
     ("AOI 0\nColour red\n", None, r"line 9: unexpected 'Colour'"),
     (BLOCK + BLOCK, None, r"line 12: a second block for AOI 0 \(value\): the first is at "
                           r"line 8"),

@@ -223,10 +223,27 @@ def _tokens(lines: list[str]) -> tuple[list[str], list[int], list[str]]:
         body, hash_, rest = raw.partition("#")
         if hash_:
             comments.append(rest.strip())
-        for w in body.split():
-            words.append(w)
-            nums.append(i + 1)
+        split = body.split()
+        words.extend(split)
+        nums.extend([i + 1] * len(split))
     return words, nums, comments
+
+
+#: one plain number (no ``nan``/``inf``, no ``_``), many of them blank-separated
+_PLAIN = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
+_PLAIN_RUN = re.compile(rf"{_PLAIN}(?: {_PLAIN})*", re.ASCII)
+
+
+def _values(words: list[str], lines: list[int], k: int, n: int, tis_line: int, path: Path
+            ) -> np.ndarray:
+    """The ``n`` values from word ``k`` as one array (checked in one pass: plain numbers
+    only; the first culprit named with its line otherwise)."""
+    chunk = words[k:k + n]
+    if _PLAIN_RUN.fullmatch(" ".join(chunk)):
+        return np.asarray(chunk, dtype=float)
+    bad = next(j for j, w in enumerate(chunk) if not re.fullmatch(_PLAIN, w, re.ASCII))
+    raise FormatError(f"expected value {bad + 1} of {n} of the block of TIS line {tis_line}, "
+                      f"found {chunk[bad][:40]!r}", path, lines[k + bad])
 
 
 def _number(words: list[str], lines: list[int], k: int, what: str, path: Path) -> float:
@@ -348,11 +365,7 @@ def _data(words: list[str], lines: list[int], k: int, n_values: int, path: Path
             raise FormatError(f"the file ends inside the block of TIS line {ln}: "
                               f"{len(words) - k - 2} of {n_values} values (ScatterAzimuth x "
                               "ScatterRadial)", path, lines[-1])
-        vals = np.empty(n_values)
-        for j in range(n_values):
-            vals[j] = _number(words, lines, k + 2 + j, f"value {j + 1} of {n_values} of the "
-                              f"block of TIS line {ln}", path)
-        blocks.append(_Block(blk, vals, ln))
+        blocks.append(_Block(blk, _values(words, lines, k + 2, n_values, ln, path), ln))
         blk = {}
         k += 2 + n_values
     raise FormatError("no DataEnd after the last block (the file may be cut short)", path,

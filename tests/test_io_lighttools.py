@@ -546,3 +546,18 @@ def test_libbsdf_reads_the_handwritten_file_as_we_do():
             k = (m.original["aoi"] == a) & (m.original["scatter_radial"] == b) & (
                 m.original["scatter_azimuth"] == 0)
         assert m.values[k, 0][0] == pytest.approx(val, rel=1e-6)
+
+
+def test_a_fit_is_written_one_channel_a_file(tmp_path):
+    """A fit: its only channel, or the one asked for; the channel's wavelength kept."""
+    res = rb.fit(rb.model("lambertian", rho=0.3), read(XYZ))
+    with pytest.raises(ArgumentError, match=r"3 channels \(X, Y, Z\).*channel="):
+        to_lighttools(res, tmp_path / "a.bsdf")
+    out = to_lighttools(res, tmp_path / "a.bsdf", channel="Y")
+    m = read(out.path)
+    # the fitted Lambertian's constant rho/pi, to the printed precision
+    assert np.allclose(m.values, res["Y"].model.params["rho"] / math.pi, rtol=1e-7)
+    mono = rb.fit(rb.model("lambertian", rho=0.3), read(HAND))
+    assert read(to_lighttools(mono, tmp_path / "b.bsdf").path).channels == ["550nm"]
+    with pytest.raises(ArgumentError, match="applies to a fit"):
+        to_lighttools(_model(), tmp_path / "c.bsdf", channel="Y")

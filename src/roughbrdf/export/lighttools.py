@@ -90,6 +90,28 @@ def default_grid(angles_of_incidence: Any = None, *, radial: Any = None, azimuth
                             value=exc.value) from None
 
 
+def _one_model(obj: Any, channel: Any) -> tuple[Any, str | None]:
+    """The model to write and its channel label: a Model or callable as given; one channel of
+    a fit (``rb.fit(...)``, its ``channels`` of ``ChannelFit``) - the only one, or
+    ``channel``. A LightTools file holds one model: libbsdf reads no file with several
+    Monochrome wavelengths, so a fit of several channels is written one file per channel."""
+    chans = getattr(obj, "channels", None)
+    if chans is None or callable(getattr(obj, "brdf", None)):
+        if channel is not None:
+            raise ArgumentError("channel", "applies to a fit; a model is one file",
+                                value=channel)
+        return obj, None
+    if channel is None:
+        if len(chans) != 1:
+            raise ArgumentError("channel", f"the fit has {len(chans)} channels "
+                                f"({', '.join(str(c.channel) for c in chans)}); a LightTools "
+                                "file holds one: give channel= (one file per channel)",
+                                value=None)
+        return chans[0].model, str(chans[0].channel)
+    c = obj[channel]
+    return c.model, str(c.channel)
+
+
 def _brdf_of(model: Any) -> Callable[..., Any]:
     """The BRDF function of a model (``.brdf``) or a plain callable."""
     if hasattr(model, "brdf") and callable(model.brdf):
@@ -265,15 +287,16 @@ def _wavelength_nm(wavelength_nm: Any) -> float | None:
 
 def to_lighttools(model: Any, out: str | os.PathLike, *, angles_of_incidence: Any = None,
                   radial: Any = None, azimuth: Any = None, symmetry: str = "Asymmetric",
-                  polarization: Any = None, wavelength_nm: Any = None, overwrite: bool = False,
-                  allow_energy_gain: bool = False) -> LightToolsFile:
+                  polarization: Any = None, wavelength_nm: Any = None, channel: Any = None,
+                  overwrite: bool = False, allow_energy_gain: bool = False) -> LightToolsFile:
     """Write a model's BRDF as a LightTools BSDF file.
 
     Parameters
     ----------
-    model : Model or callable
-        A roughbrdf model (``model.brdf(theta_i, theta_r, phi)``) or a function of the same
-        three angles (radians, roughbrdf's frame) returning the BRDF in sr⁻¹.
+    model : Model, callable or FitResult
+        A roughbrdf model (``model.brdf(theta_i, theta_r, phi)``), a function of the same
+        three angles (radians, roughbrdf's frame) returning the BRDF in sr⁻¹, or a fit (its
+        one channel, or ``channel``).
     out : str or path-like
         The file (``.bsdf`` added when it has no suffix).
     angles_of_incidence, radial, azimuth : array_like, optional
@@ -285,7 +308,10 @@ def to_lighttools(model: Any, out: str | os.PathLike, *, angles_of_incidence: An
     polarization : optional
         Incident polarization (:meth:`Model.brdf`); default unpolarized.
     wavelength_nm : float, optional
-        Written as each block's ``Wavelength`` (nm).
+        Written as each block's ``Wavelength`` (nm); for a fit's channel named ``"550nm"``
+        that wavelength by default.
+    channel : str or int, optional
+        The channel of a fit to write.
     overwrite : bool
         Replace an existing file (default: refuse before any work).
     allow_energy_gain : bool
@@ -318,8 +344,11 @@ def to_lighttools(model: Any, out: str | os.PathLike, *, angles_of_incidence: An
     if path.suffix == "":
         path = path.with_suffix(".bsdf")
     refuse_existing(path, overwrite)
+    model, label = _one_model(model, channel)
     _brdf_of(model)
-    wl = _wavelength_nm(wavelength_nm)
+    named = re.fullmatch(r"\s*([0-9.]+)\s*nm\s*", label or "")
+    wl = _wavelength_nm(wavelength_nm if wavelength_nm is not None or named is None
+                        else named.group(1))
     notes = refuse_energy_gain({None: model}, allow_energy_gain) if isinstance(model, Model) \
         else []
     grid = default_grid(angles_of_incidence, radial=radial, azimuth=azimuth, symmetry=symmetry)
@@ -335,7 +364,9 @@ def to_lighttools(model: Any, out: str | os.PathLike, *, angles_of_incidence: An
         how = "the model's directional-hemispherical reflectance (roughbrdf.albedo)"
     else:
         tis, how = integral, "the table's own cosine-weighted integral (trapezoid rule)"
-    comments = [f"roughbrdf export of {model!r}", "LightTools BSDF as read by libbsdf's "
+    comments = [f"roughbrdf export of {model!r}"
+                + ("" if label is None else f" (channel {label})"),
+                "LightTools BSDF as read by libbsdf's "
                 "LightToolsBsdfReader: BRDF in sr^-1; AOI = theta_i; ScatterRadial = polar "
                 "angle from the normal; ScatterAzimuth about the normal, source at 90 deg, "
                 "specular at 270 deg", f"TIS = {how}; the table's own integral is within "

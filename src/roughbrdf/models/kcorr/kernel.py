@@ -1,9 +1,9 @@
 """Compiled parts of the K-correlation model: Rayleigh–Rice Jones elements, ABC PSD, drivers.
 
 First-order vector perturbation (Rayleigh–Rice) theory for a single rough interface in the
-smooth-surface limit (Rice 1951; Church & Zavada 1975; Stover, *Optical Scattering*, 3rd ed.,
-Eq. 5.14 and §5.2; Germer, *Appl. Opt.* 36, 8798 (1997), Eqs. 1-4 there; NIST SCATMECH
-``code/urough.cpp``, ``Microroughness_BRDF_Model::jones``):
+smooth-surface limit (Rice 1951; Church & Zavada 1975; Stover, *Optical Scattering*, the
+Rayleigh–Rice chapter; Germer, *Appl. Opt.* 36, 8798 (1997), cited by SCATMECH for these
+elements; NIST SCATMECH ``code/urough.cpp``, ``Microroughness_BRDF_Model::jones``):
 
 .. math::
 

@@ -77,7 +77,7 @@ class KCorrelation(Model):
     ``S_2(f) = A / (1 + (B f)^2)^(C/2)`` the 2-D PSD (SCATMECH's ``ABC_PSD_Function``) and ``Q``
     the Rayleigh–Rice polarization factor of the complex index ``n + i k``
     (:mod:`roughbrdf.models.kcorr.kernel`; NIST SCATMECH ``Microroughness_BRDF_Model``; Stover,
-    *Optical Scattering*, 3rd ed., Eq. 5.14; Church & Takacs). Valid where the surface is
+    *Optical Scattering*; Church & Takacs). Valid where the surface is
     smooth, ``4 pi sigma cos theta_i / lambda << 1``; no specular peak is included (the model
     is the diffuse part only, as every stray-light scatter model).
 
@@ -101,8 +101,8 @@ class KCorrelation(Model):
     name = "k-correlation"
     aliases = ("kcorr", "abc", "k-correlation-rayleigh-rice")
     short = "kcorr"
-    reference = ("Rayleigh-Rice (Rice 1951; Church & Zavada 1975; Stover, Optical Scattering, "
-                 "Eq. 5.14) with the ABC/K-correlation PSD (Church & Takacs); NIST SCATMECH "
+    reference = ("Rayleigh-Rice (Rice 1951; Church & Zavada 1975; Stover, Optical Scattering) "
+                 "with the ABC/K-correlation PSD (Church & Takacs); NIST SCATMECH "
                  "Microroughness_BRDF_Model + ABC_PSD_Function")
     PARAMETERS = (
         positive("A", 1e-5, (1e-14, 1e3), "um^4", "ABC PSD amplitude S_2(0) (2-D PSD)"),

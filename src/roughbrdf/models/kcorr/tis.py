@@ -29,7 +29,7 @@ the tested bound, up to ``theta_i = 80°`` (tests/test_straylight_kcorr.py).
 Small-roughness closed form (:func:`tis_smooth_limit`)
 ------------------------------------------------------
 ``TIS ≈ (4 pi sigma cos theta_i / lambda)^2 R(theta_i)`` (Davies 1954; Bennett & Porteus 1961;
-Stover Eq. 2.8 for normal incidence), ``R`` the Fresnel reflectance of the incident
+Stover, *Optical Scattering*), ``R`` the Fresnel reflectance of the incident
 polarization and ``sigma`` the total rms roughness. It follows from the model when all of the
 PSD lies near the specular point, where ``Q -> R`` and ``cos theta_r -> cos theta_i``: it needs
 ``C > 2`` and ``B >> lambda`` (correlation length much longer than the wavelength). Its

@@ -247,6 +247,10 @@ def test_aoi_180_is_normal_incidence_as_libbsdf_reads_it(tmp_path):
     (BLOCK, "Symmetry Round\nScatterAzimuth 2\n0 360\nScatterRadial 2\n0 90\n",
      r"line 1: Symmetry 'Round'"),
     (BLOCK, "Symmetry Asymmetric\nScatterAzimuth 2\n0 360\n", r"no ScatterRadial"),
+    (BLOCK, "ScatterAzimuth 2\n0 360\nScatterRadial 2\n0 90\nSymmetry\n",
+     r"line 5: Symmetry has no value"),
+    (BLOCK, "Symmetry Asymmetric\nScatterAzimuth 2\n0 360\nScatterRadial 2\n0 90\n"
+     "SpectralContent RGB\n", r"line 6: SpectralContent 'RGB' is not Monochrome or XYZ"),
     (BLOCK, "Symmetry Asymmetric\nScatterAzimuth 2\n0 400\nScatterRadial 2\n0 90\n",
      r"ScatterAzimuth: angles must lie in \[0, 360\]"),
     ("AOI 0\nTIS 0.3\n0.1 0.1\n0.1 oops\n", None, r"line 11: expected value 4 of 4"),

@@ -282,7 +282,9 @@ def _header(words: list[str], lines: list[int], path: Path
             angles[w] = [_number(words, lines, k + 2 + j, f"angle {j + 1} of {int(n)} after "
                                  f"{w} (line {ln})", path) for j in range(int(n))]
             k += 2 + int(n)
-        elif w in ("Symmetry", "SpectralContent") and k + 1 < len(words):
+        elif w in ("Symmetry", "SpectralContent"):
+            if k + 1 >= len(words) or words[k + 1].lower() == "databegin":
+                raise FormatError(f"{w} has no value", path, ln)
             if w in keys:
                 raise FormatError(f"{w} is given twice: line {keys[w][1]} and line {ln}",
                                   path, ln)

@@ -109,6 +109,7 @@ def test_options_are_frozen_and_replace_makes_a_checked_copy():
     ({"joint": "yes"}, "joint", "must be True or False"),
     ({"shared": ["alpha"]}, "shared", "only a joint fit shares parameters"),
     ({"polarimetric_weight": -1.0}, "polarimetric_weight", "must be a finite number >= 0"),
+    ({"wavelength": "630"}, "wavelength", "must be a number and a unit"),
 ])
 def test_a_bad_option_raises_when_the_options_are_made(kw, argument, text):
     with pytest.raises(ArgumentError) as err:
@@ -120,7 +121,8 @@ def test_every_option_of_fit_is_a_field_with_the_same_default():
     fields = {f.name: f.default for f in dataclasses.fields(FitOptions)}
     assert fields["loss"] == "auto" and fields["starts"] == 8 and fields["seed"] == 0
     assert fields["subsample"] == 1000 and fields["aperture_points"] == 19
-    assert len(fields) == 26 and fields["energy_constraint"] is True
+    assert len(fields) == 27 and fields["energy_constraint"] is True
+    assert fields["wavelength"] is None
     assert "model" not in fields and "measurement" not in fields
     assert FitOptions().changed() == {} and FitOptions(fix=[]).changed() == {}
 

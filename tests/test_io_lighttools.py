@@ -510,11 +510,12 @@ def test_libbsdf_interpolates_our_file_bilinearly_between_nodes():
     most at these directions (measured; bound 6 %)."""
     ti, to, po, v, node = _libbsdf_dirs(ASYM.name)
     ti, to, po, v = ti[~node], to[~node], po[~node], v[~node]
-    t0, p0 = np.floor(to / 5) * 5, np.floor(po / 15) * 15
-    wt, wp = (to - t0) / 5, (po - p0) / 15
-    bil = ((1 - wt) * (1 - wp) * _model_at(ti, t0, p0) + wt * (1 - wp) * _model_at(ti, t0 + 5, p0)
-           + (1 - wt) * wp * _model_at(ti, t0, p0 + 15)
-           + wt * wp * _model_at(ti, t0 + 5, p0 + 15))
+    rad0, azi0 = np.floor(to / 5) * 5, np.floor(po / 15) * 15
+    wt, wp = (to - rad0) / 5, (po - azi0) / 15
+    bil = ((1 - wt) * (1 - wp) * _model_at(ti, rad0, azi0)
+           + wt * (1 - wp) * _model_at(ti, rad0 + 5, azi0)
+           + (1 - wt) * wp * _model_at(ti, rad0, azi0 + 15)
+           + wt * wp * _model_at(ti, rad0 + 5, azi0 + 15))
     assert np.max(np.abs(v / bil - 1)) < 1e-6
     assert np.max(np.abs(v / _model_at(ti, to, po) - 1)) < 0.06
 

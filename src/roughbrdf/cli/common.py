@@ -53,7 +53,8 @@ FIT_OPTIONS = {"model": "--model", "fix": "--fix", "bounds": "--bounds", "channe
                "theta_r_max": "--theta-r-max", "source_exclusion": "--source-exclusion",
                "overwrite": "--force", "plots": "--plots/--no-plots", "joint": "--joint",
                "shared": "--shared", "extrapolated": "--keep-extrapolated",
-               "candidates": "--models", "cv": "--cv/--no-cv"}
+               "candidates": "--models", "cv": "--cv/--no-cv", "wavelength": "--wavelength",
+               "max_rows": "--max-rows"}
 COMPARE_OPTIONS = {"candidates": "--models", "models": "--models", "cv": "--cv/--no-cv",
                    "channel": "--channel", "loss": "--loss", "starts": "--starts",
                    "joint": "--joint", "quantity": "--quantity", "angles": "--angles-in",
@@ -61,7 +62,7 @@ COMPARE_OPTIONS = {"candidates": "--models", "models": "--models", "cv": "--cv/-
                    "theta_r_max": "--theta-r-max", "source_exclusion": "--source-exclusion",
                    "extrapolated": "--keep-extrapolated", "negative": "--negative",
                    "seed": "--seed", "plots": "--plots/--no-plots", "overwrite": "--force",
-                   "out_dir": "--out"}
+                   "out_dir": "--out", "wavelength": "--wavelength"}
 PLOT_OPTIONS = {"theta_i": "--theta-i", "elevation": "--elevation", "quantity": "--quantity",
                 "kind": "--kind", "log": "--log/--linear", "channel": "--channel",
                 "overwrite": "--force", "path": "--out"}

@@ -232,6 +232,32 @@ def resolve_model(given: ModelInput, options: FitOptions) -> tuple[Model | str, 
     return start_within(m, ranges, params), options.replace(fix=fixed, bounds=ranges or None)
 
 
+def run_per_incidence(file: str, out: str, given: ModelInput, options: FitOptions,
+                      read: ReadInput, *, max_rows: int, force: bool, quiet: bool) -> int:
+    """``roughbrdf fit --per-incidence``: one parameter set per measured incidence, at most
+    ``--max-rows`` rows kept as an optical code's catalog holds them
+    (:func:`roughbrdf.fitting.per_incidence.fit_per_incidence`); writes ``fit.json`` and
+    ``report.txt``. Exit status 1 as for a fit, if any row's fit is not to be trusted."""
+    from ..fitting.per_incidence import fit_per_incidence
+    from ..output import ResultFolder
+
+    if given.auto:
+        raise ValueError("--per-incidence fits one model: name it with --model")
+    if options.joint:
+        raise ValueError("--per-incidence fits each incidence on its own; drop --joint")
+    m, options = resolve_model(given, options)
+    meas = read_input(file, read.file_format, read.quantity, read.angles_in)
+    ResultFolder(out, overwrite=force).check(["fit.json", "report.txt"])
+    with energy_warnings():
+        res = fit_per_incidence(m, meas, max_rows=max_rows, options=options)
+    written = res.save(out, overwrite=force)
+    if not quiet:
+        typer.echo(res.report())
+    typer.echo("wrote " + ", ".join(str(p) for p in written))
+    trusted = all([echo_untrusted(r.result) for r in res.rows])
+    return 0 if res.success and trusted else 1
+
+
 def run_fit(file: str, out: str, given: ModelInput, options: FitOptions, read: ReadInput, *,
             cv: bool, plots: bool, force: bool, quiet: bool) -> int:
     """The work of ``roughbrdf fit``; returns the exit status (0, or 1 if not converged, on a
@@ -294,7 +320,8 @@ def echo_untrusted(res: FitResult) -> bool:
 
 
 #: the parameters of ``roughbrdf fit``, in the order of its help
-FIT_ORDER = ["file", "model", "models", "cv", "joint", "shared", "keep_extrapolated", "out",
+FIT_ORDER = ["file", "model", "models", "cv", "joint", "shared", "per_incidence", "max_rows",
+             "keep_extrapolated", "out",
              "param", "fix", "bounds", "channel", "loss", "starts", "quantity", "angles_in",
              "relative_to", "file_format", "nonfinite", "negative", "seed", "free_scale",
              "aperture", "theta_r_max", "source_exclusion", "plots", "force", "quiet"]
@@ -316,6 +343,12 @@ FIT_OWN: dict[str, tuple[Any, Any]] = {
                         "not write are never replaced)")], False),
     "quiet": (Annotated[bool, typer.Option("--quiet", "-q", help="no report on the terminal")],
               False),
+    "per_incidence": (Annotated[bool, typer.Option(
+        "--per-incidence", help="one parameter set per measured incidence, the rows an optical "
+                                "code's catalog keeps (Zemax ABg: up to 10, interpolated in "
+                                "cos theta_i); writes fit.json and report.txt")], False),
+    "max_rows": (Annotated[int, typer.Option(
+        "--max-rows", min=2, help="with --per-incidence: rows kept at most")], 10),
 }
 
 
@@ -324,9 +357,15 @@ def register(app: typer.Typer) -> None:
         """Fit a model to a measurement file; write fit.json, report.txt and plots into --out."""
         with handled(OPTIONS):
             options = fit_options(values, progress=None if not values["quiet"] else False)
-            code = run_fit(values["file"], values["out"], ModelInput.of(values), options,
-                           ReadInput.of(values), cv=values["cv"], plots=values["plots"],
-                           force=values["force"], quiet=values["quiet"])
+            if values["per_incidence"]:
+                code = run_per_incidence(values["file"], values["out"], ModelInput.of(values),
+                                         options, ReadInput.of(values),
+                                         max_rows=values["max_rows"], force=values["force"],
+                                         quiet=values["quiet"])
+            else:
+                code = run_fit(values["file"], values["out"], ModelInput.of(values), options,
+                               ReadInput.of(values), cv=values["cv"], plots=values["plots"],
+                               force=values["force"], quiet=values["quiet"])
         if code:
             raise typer.Exit(code)
 

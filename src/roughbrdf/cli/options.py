@@ -94,6 +94,11 @@ EnergyConstraintOption = Annotated[bool, typer.Option(
          "0, 5, ... 85, 89 deg) under albedo <= 1 there; --no-energy-constraint: the "
          "unconstrained fit")]
 
+WavelengthOption = Annotated[str | None, typer.Option(
+    "--wavelength", metavar="WL",
+    help="wavelength of every channel for models that need one (k-correlation), in um or "
+         "with a unit (630nm); default: from the file or the channel names")]
+
 #: every shared option: parameter name -> (typer annotation, default)
 TABLE: dict[str, tuple[Any, Any]] = {
     "models": (ModelsOption, None), "cv": (CvOption, True), "joint": (JointOption, False),
@@ -107,12 +112,13 @@ TABLE: dict[str, tuple[Any, Any]] = {
     "free_scale": (FreeScaleOption, None), "aperture": (ApertureOption, None),
     "theta_r_max": (ThetaRMaxOption, None), "source_exclusion": (SourceExclusionOption, None),
     "plots": (PlotsOption, True), "energy_constraint": (EnergyConstraintOption, True),
+    "wavelength": (WavelengthOption, None),
 }
 #: the CLI values that are FitOptions fields as they are
 _AS_GIVEN = ("loss", "starts", "seed", "nonfinite", "negative", "relative_to", "free_scale",
-             "joint", "energy_constraint")
+             "joint", "energy_constraint", "wavelength")
 #: options every verb that fits takes (those whose ``order`` has ``starts``), placed after it
-_FITTING = ("energy_constraint",)
+_FITTING = ("energy_constraint", "wavelength")
 
 
 def command(func: Callable[..., Any], order: list[str],

@@ -18,9 +18,12 @@ themselves); else greedily from the first and last incidence, adding the row tha
 
 from __future__ import annotations
 
+import json
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -125,6 +128,22 @@ class PerIncidenceFit:
         return {"model": self.model_name, "per_incidence": True, "rows": rows,
                 "interpolation": "linear in cos(theta_i); first row below, last row above",
                 "tis_error": self.tis_error, "rms_log": self.rms_log}
+
+    def save(self, out_dir: str | os.PathLike, *, overwrite: bool = False) -> list[Path]:
+        """Write ``fit.json`` (:meth:`to_dict`, with the measurement's file) and ``report.txt``
+        (:meth:`report`) into ``out_dir`` as one set (:class:`roughbrdf.output.ResultFolder`:
+        an earlier run's results or a file of those names refused unless ``overwrite``)."""
+        from ..output import ResultFolder
+        from .data import input_source
+
+        doc = {**self.to_dict(), **input_source(self.rows[0].result.measurement)}
+        files = {"fit.json": json.dumps(doc, indent=2, default=float) + "\n",
+                 "report.txt": self.report()}
+        with ResultFolder(out_dir, overwrite=overwrite) as out:
+            out.check(list(files))
+            for name, content in files.items():
+                out.add(name, content)
+        return [out.path / n for n in files]
 
     def report(self) -> str:
         """A text table per channel: each row's incidence, parameters and TIS, and the two

@@ -1,17 +1,20 @@
 """Readers and writers of measured-BRDF files; one module per format (Zemax: a package).
 
-========  ====================  ==============================================  ======  ======
-format    extensions            module                                          read    write
-========  ====================  ==============================================  ======  ======
-astm      ``.astm``             :mod:`roughbrdf.io.astm` (ASTM E1392 text)      yes     yes
-alta      ``.dat``, ``.alta``   :mod:`roughbrdf.io.alta` (ALTA text)            yes     yes
-merl      ``.binary``, ``.merl``  :mod:`roughbrdf.io.merl` (MERL 2003 binary)   yes     yes
-csv       ``.csv``              :mod:`roughbrdf.io.csv` (roughbrdf CSV)         yes     yes
-zemax     ``.bsdf``             :mod:`roughbrdf.io.zemax` (Zemax tabular BSDF)  yes     yes
-========  ====================  ==============================================  ======  ======
+==========  ======================  ================================================  ====  =====
+format      extensions              module                                            read  write
+==========  ======================  ================================================  ====  =====
+astm        ``.astm``               :mod:`roughbrdf.io.astm` (ASTM E1392 text)        yes   yes
+alta        ``.dat``, ``.alta``     :mod:`roughbrdf.io.alta` (ALTA text)              yes   yes
+merl        ``.binary``, ``.merl``  :mod:`roughbrdf.io.merl` (MERL 2003 binary)       yes   yes
+csv         ``.csv``                :mod:`roughbrdf.io.csv` (roughbrdf CSV)           yes   yes
+zemax       ``.bsdf``               :mod:`roughbrdf.io.zemax` (Zemax tabular BSDF)    yes   yes
+lighttools  ``.bsdf``               :mod:`roughbrdf.io.lighttools` (LightTools BSDF)  yes   yes
+==========  ======================  ================================================  ====  =====
 
 ``read(path)`` chooses the format from the extension (``format=`` overrides); when the
-extension is unknown it looks at the first bytes. Every problem with a file raises
+extension is unknown it looks at the first bytes. Zemax and LightTools share ``.bsdf``: an
+existing ``.bsdf`` file is read by its contents (:func:`roughbrdf.io.lighttools.sniff_bsdf`),
+a new one is written as Zemax unless ``format="lighttools"``. Every problem with a file raises
 :class:`FormatError` (a ``ValueError``) whose message starts with the path and, where one line is
 at fault, the line number (also in ``.path`` and ``.line``).
 
@@ -70,9 +73,11 @@ __all__ = ["read", "write", "FormatError", "FormatWarning", "ImplausibleAnglesWa
            "LossyWriteWarning", "UnterminatedRowWarning", "FORMATS", "format_for"]
 
 #: format name -> module name under roughbrdf.io
-FORMATS = {"astm": "astm", "alta": "alta", "merl": "merl", "csv": "csv", "zemax": "zemax"}
+#: (zemax before lighttools: a new .bsdf file is written as Zemax unless told otherwise)
+FORMATS = {"astm": "astm", "alta": "alta", "merl": "merl", "csv": "csv", "zemax": "zemax",
+           "lighttools": "lighttools"}
 _ALIASES = {"ascii": "alta", "dat": "alta", "binary": "merl", "e1392": "astm", "txt": "alta",
-            "bsdf": "zemax", "opticstudio": "zemax"}
+            "bsdf": "zemax", "opticstudio": "zemax", "lt": "lighttools"}
 
 
 def _module(fmt: str):
@@ -124,6 +129,10 @@ def _sniff(path: Path) -> str | None:
     if re.search(r"^VARS\s", text, re.MULTILINE) and re.search(r"^NUM_POINTS\s", text,
                                                                  re.MULTILINE):
         return "astm"
+    # LightTools BSDF: its blocks start with AOI lines (it shares Zemax's ScatterAzimuth N /
+    # ScatterRadial N header lines, so it is told first; libbsdf's classifyFile does the same)
+    if re.search(r"^\s*AOI\s", text, re.MULTILINE):
+        return "lighttools"
     # Zemax tabular BSDF: the counted keywords of its header (comments may come first)
     counted = re.findall(r"^\s*(SampleRotation|AngleOfIncidence|ScatterAzimuth|ScatterRadial)"
                          r"\s+\d+\s*$", text, re.MULTILINE | re.IGNORECASE)
@@ -157,12 +166,13 @@ def read(path: str | os.PathLike, format: str | None = None, **options: Any) -> 
     Parameters
     ----------
     path : str or path-like
-    format : {"astm", "alta", "merl", "csv", "zemax"}, optional
-        Override the format chosen from the extension.
+    format : {"astm", "alta", "merl", "csv", "zemax", "lighttools"}, optional
+        Override the format chosen from the extension (a ``.bsdf`` file: by its contents).
     **options
         Passed to the format's reader, e.g. ``quantity="brdf_cos"`` (ALTA without
         ``#PARAM_OUT``), ``angles="deg"`` (ASTM), ``stride=4`` (MERL),
-        ``sample_rotation="all"`` (Zemax, several sample rotations). ``quantity=`` and
+        ``sample_rotation="all"`` (Zemax, several sample rotations), ``side="back"``
+        (LightTools: the other side's blocks). ``quantity=`` and
         ``angles=`` supply what the file does not say; if the file says otherwise they raise
         :class:`FormatError` (every reader accepts both).
 
@@ -183,6 +193,10 @@ def read(path: str | os.PathLike, format: str | None = None, **options: Any) -> 
     if not p.exists():
         raise FileNotFoundError(f"{p}: no such file")
     fmt = format_for(p, format)
+    if format is None and p.suffix.lower() == ".bsdf":  # Zemax or LightTools: by content
+        from .lighttools import sniff_bsdf
+
+        fmt = sniff_bsdf(p)
     measurement = _module(fmt).read(p, **options)
     # samples the instrument's software filled in (roughbrdf.extrapolation): recorded in meta,
     # left out by fits unless asked; the values are not changed
@@ -199,8 +213,9 @@ def write(measurement: Measurement, path: str | os.PathLike, format: str | None 
     measurement : Measurement
     path : str or path-like
         The file to write; never the file ``measurement`` was read from.
-    format : {"astm", "alta", "merl", "csv", "zemax"}, optional
-        Override the format chosen from the extension.
+    format : {"astm", "alta", "merl", "csv", "zemax", "lighttools"}, optional
+        Override the format chosen from the extension (``.bsdf``: Zemax unless
+        ``"lighttools"``).
     overwrite : bool
         Replace an existing file (default: refuse with :class:`FileExistsError`).
     **options
@@ -227,6 +242,10 @@ def write(measurement: Measurement, path: str | os.PathLike, format: str | None 
         in anything but CSV).
     """
     fmt = format_for(path, format)
+    if fmt == "lighttools":  # its writer lives with the model writer (no import cycle)
+        from ..export.lighttools import write_measurement
+
+        return write_measurement(measurement, path, overwrite=overwrite, **options)
     mod = _module(fmt)
     if not hasattr(mod, "write"):
         raise FormatError(f"format {fmt!r} has no writer", path)

@@ -27,6 +27,7 @@ import textwrap
 
 import numpy as np
 import pytest
+from scipy.integrate import quad
 from scipy.special import betainc
 
 import roughbrdf as rb
@@ -314,6 +315,45 @@ def test_grazing_tis_of_a_sharp_lobe_is_half_the_plane():
         == pytest.approx(0.5, abs=2e-3)
     assert sl.harvey_shack_tis(HALF_PI, 1e3, 1e-5, -3.0) \
         / sl.harvey_shack_tis_plane(1e3, 1e-5, -3.0) == pytest.approx(0.5, abs=2e-3)
+
+
+def _radius(ti: float, psi: float) -> float:
+    """Distance from β0 = (sin ti, 0) to the unit circle along ψ (the chord of the disk)."""
+    s, c, cp = math.sin(ti), math.cos(ti), math.cos(psi)
+    q = math.sqrt(c * c + s * s * cp * cp)
+    return c * c / (q + s * cp) if cp > 0 else q - s * cp
+
+
+def _adaptive_tis(radial, ti: float) -> float:
+    # SciPy's adaptive quad on 2 ∫_0^π G(R(ψ)) dψ, breakpoints where R changes fastest
+    pts = [math.pi / 2 + x for x in (-1e-2, -1e-4, -1e-6, 0.0, 1e-6, 1e-4, 1e-2)]
+    return 2 * quad(lambda p: radial(_radius(ti, p)), 0.0, math.pi, points=pts, limit=2000,
+                    epsabs=0.0, epsrel=1e-12)[0]
+
+
+@pytest.mark.parametrize("deg", [60.0, 89.9, 89.999, 89.9999])
+def test_harvey_shack_tis_equals_adaptive_quadrature_near_grazing(deg):
+    # independent rule on the same exact reduction; a lobe 1e-5 wide, beta0 1e-8 from the rim
+    b0, L, S = 1.0, 1e-5, -3.0
+    ti = math.radians(deg)
+    exact = _adaptive_tis(lambda r: sl.harvey_shack_radial(r, b0, L, S), ti)
+    assert sl.harvey_shack_tis(ti, b0, L, S) == pytest.approx(exact, rel=1e-8)
+
+
+@pytest.mark.parametrize("deg", [60.0, 89.0])
+def test_sharp_abg_tis_equals_adaptive_quadrature_at_oblique_incidence(deg):
+    # B = 2e-12: a lobe 1.3e-4 wide in |β - β0|, which rb.albedo's angle grid cannot resolve;
+    # G(r) by adaptive quad with breakpoints around the knee B^(1/g)
+    A, B, g = 1e-9, 2e-12, 3.0
+    w = B ** (1 / g)
+
+    def radial(r: float) -> float:
+        pts = [p for p in (0.1 * w, w, 10 * w, 100 * w) if p < r] or None
+        return quad(lambda x: A * x / (B + x**g), 0.0, r, points=pts, limit=500,
+                    epsabs=0.0, epsrel=1e-12)[0]
+
+    ti = math.radians(deg)
+    assert sl.abg_tis(ti, A, B, g) == pytest.approx(_adaptive_tis(radial, ti), rel=1e-9)
 
 
 # ------------------------------------------------------------------------------------------

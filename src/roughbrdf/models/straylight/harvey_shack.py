@@ -62,7 +62,7 @@ class HarveyShack(Model):
     """
 
     name = "harvey-shack"
-    aliases = ("hs", "harveyshack", "harvey")
+    aliases = ("hs", "harveyshack")
     short = "hs"
     reference = "FRED help, Scatter Types > Harvey-Shack (modified three-term Harvey model)"
     PARAMETERS = (

@@ -31,6 +31,12 @@ from roughbrdf.models.parameters import REFLECTANCE_DOMAIN, ReadOnlyDict
 
 HALF_PI = 0.5 * math.pi
 MODEL_NAMES = rb.available()
+#: what a model cannot be evaluated without (K-correlation: the wavelength, in um)
+REQUIRED = {"k-correlation": {"wavelength": 0.633}}
+
+
+def _model(name):
+    return rb.model(name, **REQUIRED.get(name, {}))
 
 #: every reflectance-like parameter (a part's directional-hemispherical reflectance), by model;
 #: docs/models.md: Lambertian rho and TR75 rho_L (Eq. 32), TS67 rho_d (its diffuse part is
@@ -38,7 +44,9 @@ MODEL_NAMES = rb.available()
 #: ratio), RB08 rho and rho_r (lobe widths).
 REFLECTANCES = {"lambertian": {"rho"}, "trowbridge-reitz-1975": {"rho_L"},
                 "torrance-sparrow-1967": {"rho_d"}, "renhorn-boreman-2008": {"bulk", "retro"},
-                "microfacet": set(), "coated": {"rho"}, "oren-nayar": {"rho"}}
+                "microfacet": set(), "coated": {"rho"}, "oren-nayar": {"rho"},
+                # the stray-light models: a scale A or b0 (sr^-1), no reflectance
+                "abg": set(), "harvey-shack": set(), "k-correlation": set()}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -46,7 +54,7 @@ REFLECTANCES = {"lambertian": {"rho"}, "trowbridge-reitz-1975": {"rho_L"},
 # ---------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("name", MODEL_NAMES)
 def test_params_item_assignment_raises_and_names_with_params(name):
-    m = rb.model(name)
+    m = _model(name)
     p = next(iter(m.params))
     before = dict(m.params)
     for change in (lambda d: d.__setitem__(p, 0.1), lambda d: d.update({p: 0.1}),
@@ -63,7 +71,7 @@ def test_params_item_assignment_raises_and_names_with_params(name):
 
 @pytest.mark.parametrize("name", MODEL_NAMES)
 def test_attribute_named_like_a_parameter_or_option_raises(name):
-    m = rb.model(name)
+    m = _model(name)
     for attr in [*m.params, *m.options]:
         with pytest.raises(AttributeError, match=rf"cannot set '{attr}'.*with_params\({attr}="):
             setattr(m, attr, -1)
@@ -162,7 +170,7 @@ def test_angle_errors_render_in_degrees_for_the_cli():
 
 @pytest.mark.parametrize("name", MODEL_NAMES)
 def test_phi_and_gamma_stay_periodic(name):
-    m = rb.model(name)
+    m = _model(name)
     base = m.brdf(0.3, 0.5, 0.7, polarization=0.4)
     for k in (-3, 1, 100):
         assert m.brdf(0.3, 0.5, 0.7 + 2 * math.pi * k, polarization=0.4) == pytest.approx(
@@ -177,7 +185,7 @@ def test_phi_and_gamma_stay_periodic(name):
 def test_reflectance_parameters_share_one_domain():
     assert set(REFLECTANCES) == set(MODEL_NAMES)
     for name in MODEL_NAMES:
-        specs = rb.model(name).parameters
+        specs = _model(name).parameters
         found = {p.name for p in specs if p.kind == "reflectance"}
         assert found == REFLECTANCES[name], name
         for p in specs:
@@ -194,7 +202,7 @@ def test_reflectance_outside_unit_interval_is_refused_everywhere(name, param, ba
                                             r"domain \[0, 1\]"):
         rb.model(name, **{param: bad})
     with pytest.raises(ArgumentError, match=rf"'{param}'"):
-        rb.model(name).with_params(**{param: bad})
+        _model(name).with_params(**{param: bad})
 
 
 @pytest.mark.parametrize("name, param", [(n, p) for n, ps in REFLECTANCES.items() for p in ps])
@@ -258,7 +266,7 @@ def test_hypothesis_bad_angles_raise_naming_the_argument(name, which, data):
     bad = data.draw(BAD_PHI if which == "phi" else BAD_ANGLE)
     args = {"theta_i": 0.3, "theta_r": 0.4, "phi": 0.1, which: bad}
     with pytest.raises((ValueError, TypeError)) as exc:
-        rb.model(name).brdf(**args)
+        _model(name).brdf(**args)
     assert which in str(exc.value), (bad, str(exc.value))
 
 
@@ -266,7 +274,7 @@ def test_hypothesis_bad_angles_raise_naming_the_argument(name, which, data):
 @given(name=st.sampled_from(MODEL_NAMES), bad=BAD_POLARIZATION)
 def test_hypothesis_bad_polarization_raises_naming_it(name, bad):
     with pytest.raises((ValueError, TypeError)) as exc:
-        rb.model(name).brdf(0.3, 0.4, 0.1, polarization=bad)
+        _model(name).brdf(0.3, 0.4, 0.1, polarization=bad)
     assert "polarization" in str(exc.value), (bad, str(exc.value))
 
 
@@ -290,7 +298,7 @@ def _is_number(s: str) -> bool:
 @settings(max_examples=120, deadline=None)
 @given(name=st.sampled_from(MODEL_NAMES), data=st.data())
 def test_hypothesis_bad_parameter_values_raise_naming_the_parameter(name, data):
-    m = rb.model(name)
+    m = _model(name)
     param = data.draw(st.sampled_from(m.param_names))
     bad = data.draw(BAD_VALUE)
     spec = next(p for p in m.parameters if p.name == param)

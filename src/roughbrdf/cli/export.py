@@ -1,4 +1,6 @@
-"""``roughbrdf export (MODEL -p ... | --fit DIR) --to zemax|mitsuba|mitsuba-xml --out PATH``.
+"""``roughbrdf export (MODEL -p ... | --fit DIR) --to TARGET --out PATH``.
+
+Targets: zemax, mitsuba, mitsuba-xml, lighttools, zemax-abg (:data:`roughbrdf.export.TARGETS`).
 
 Writes a model, or the fitted models of a saved fit (``fit.json``), for another tool
 (:func:`roughbrdf.export.export`, ``docs/export.md``): a Zemax OpticStudio tabular BSDF
@@ -25,15 +27,27 @@ from .common import EXPORT_OPTIONS, cli_model, degree_range, handled, parse_para
 OPTIONS = {**EXPORT_OPTIONS, "allow_energy_gain": "--allow-energy-gain"}
 
 
-def _source(model: str | None, param: list[str] | None, fit_dir: str | None) -> Any:
-    """The model of MODEL and ``-p``, or the fitted models ``{channel: model}`` of ``--fit``."""
+def _source(model: str | None, param: list[str] | None, fit_dir: str | None,
+            target: str = "zemax") -> Any:
+    """The model of MODEL and ``-p``, or the fitted models ``{channel: model}`` of ``--fit``
+    (for ``--to zemax-abg`` a per-incidence fit's saved rows as they are)."""
     if (model is None) == (fit_dir is None):
         raise ValueError("give a MODEL (with -p settings) or --fit DIR, not both or neither")
     if fit_dir is not None:
         if param:
             raise ValueError("-p sets a MODEL's parameters; a fit's models are as fitted")
+        import json
+
         from ..fitting.result import fitted_models
 
+        path = Path(fit_dir) / "fit.json" if Path(fit_dir).is_dir() else Path(fit_dir)
+        if path.is_file():
+            doc = json.loads(path.read_text(encoding="utf-8"))
+            if isinstance(doc, dict) and doc.get("per_incidence"):
+                if target != "zemax-abg":
+                    raise ValueError(f"{path} is a per-incidence fit (--per-incidence): it "
+                                     "exports to --to zemax-abg (its rows)")
+                return doc
         return fitted_models(fit_dir)
     return cli_model(str(model), parse_params(param))  # -p angles (sigma) in degrees
 
@@ -58,7 +72,18 @@ def run_export(model: str | None, param: list[str] | None, fit_dir: str | None, 
     from ..export import export, target_name
 
     target = target_name(to)
-    if target == "zemax":
+    if target in ("lighttools", "zemax-abg"):
+        if rgb is not None or fit_closest or theta_max is not None:
+            raise ValueError("--rgb/--no-rgb, --fit-closest and --theta-max apply to the "
+                             "Mitsuba targets")
+        if target == "zemax-abg" and grid:
+            raise ValueError("--incidences, --radial, --azimuth and --symmetry do not apply to "
+                             "--to zemax-abg (its rows are the fit's incidences)")
+        if target == "lighttools" and set(grid) - {"angles_of_incidence"}:
+            raise ValueError("--radial, --azimuth and --symmetry are Zemax's grid (angles from "
+                             "the specular direction); --to lighttools takes --incidences")
+        options = grid
+    elif target == "zemax":
         if rgb is not None or fit_closest or theta_max is not None:
             raise ValueError("--rgb/--no-rgb, --fit-closest and --theta-max apply to the "
                              "Mitsuba targets")
@@ -74,7 +99,7 @@ def run_export(model: str | None, param: list[str] | None, fit_dir: str | None, 
             if not (math.isfinite(theta_max) and 0 < theta_max < 90):
                 raise ValueError(f"--theta-max must be in (0, 90) degrees, got {theta_max!r}")
             options["theta_max"] = math.radians(theta_max)
-    source = _source(model, param, fit_dir)
+    source = _source(model, param, fit_dir, target)
     chan: Any = channel
     if channel is not None and channel.lstrip("-").isdigit() and isinstance(source, dict) \
             and channel not in source:
@@ -91,8 +116,9 @@ def register(app: typer.Typer) -> None:
         model: Annotated[str | None, typer.Argument(
             help="model name or spec, e.g. coated(lobes=2) or microfacet+lambertian "
                  "(or --fit DIR)")] = None,
-        to: str = typer.Option(..., "--to", help="zemax (.bsdf), mitsuba (dict as JSON) or "
-                                                 "mitsuba-xml (<bsdf>)"),
+        to: str = typer.Option(..., "--to", help="zemax (.bsdf), mitsuba (dict as JSON), "
+                                                 "mitsuba-xml (<bsdf>), lighttools (.bsdf) "
+                                                 "or zemax-abg (ABg catalog values, .txt)"),
         out: str = typer.Option(..., "--out", "-o", help="the file (Zemax: one per channel "
                                                           "of a fit, <stem>_<channel>.bsdf)"),
         param: Annotated[list[str] | None, typer.Option(
@@ -126,7 +152,8 @@ def register(app: typer.Typer) -> None:
             help="export a model that reflects more than it receives (albedo > 1 at some "
                  "incidence; refused by default), recorded in the file"),
     ) -> None:
-        """Export a model or a fit to Zemax OpticStudio (.bsdf) or Mitsuba 3 (dict, XML)."""
+        """Export a model or a fit to Zemax OpticStudio (.bsdf, ABg values), LightTools (.bsdf)
+        or Mitsuba 3 (dict, XML)."""
         with handled(OPTIONS):
             run_export(model, param, fit_dir, to, out, channel=channel, force=force,
                        grid=_zemax_options(incidences, radial, azimuth, symmetry), rgb=rgb,

@@ -37,6 +37,8 @@ TARGETS = {
     "zemax": "Zemax OpticStudio tabular BSDF (.bsdf), one file per channel",
     "mitsuba": "Mitsuba 3 scene-description dict as JSON (mitsuba.load_dict(json.load(f)))",
     "mitsuba-xml": "Mitsuba 3 XML <bsdf> element (a document mitsuba.load_string loads)",
+    "lighttools": "LightTools BSDF (.bsdf), one file per channel",
+    "zemax-abg": "Zemax OpticStudio ABg catalog values (.txt table to enter; ABg fits only)",
 }
 
 
@@ -68,7 +70,8 @@ def target_name(to: str) -> str:
     :class:`~roughbrdf.errors.ArgumentError` naming ``to`` otherwise."""
     key = str(to).strip().lower().replace("_", "-")
     key = {"opticstudio": "zemax", "bsdf": "zemax", "xml": "mitsuba-xml",
-           "mitsuba-dict": "mitsuba", "json": "mitsuba"}.get(key, key)
+           "mitsuba-dict": "mitsuba", "json": "mitsuba", "abg": "zemax-abg",
+           "lt": "lighttools"}.get(key, key)
     if key not in TARGETS:
         raise ArgumentError("to", f"unknown target; choose one of {', '.join(TARGETS)}",
                             value=to)
@@ -88,8 +91,11 @@ def export(source: Any, out: str | os.PathLike, *, to: str, overwrite: bool = Fa
         The file (``.bsdf``, ``.json`` or ``.xml`` added without a suffix). A fit whose
         channels are not one BSDF gives one file per channel, ``<stem>_<channel><suffix>``
         beside it (Mitsuba: where the channels differ in more than colours).
-    to : {"zemax", "mitsuba", "mitsuba-xml"}
-        The target (:data:`TARGETS`).
+    to : {"zemax", "mitsuba", "mitsuba-xml", "lighttools", "zemax-abg"}
+        The target (:data:`TARGETS`): also LightTools BSDF files
+        (:func:`~roughbrdf.export.lighttools.to_lighttools`) and the Zemax ABg catalog
+        values of an ABg fit (:func:`~roughbrdf.export.abg_catalog.write_abg_catalog`; a
+        per-incidence fit writes its kept rows).
     overwrite : bool
         Replace existing files (default: refuse, before writing anything).
     channel : int or str, optional
@@ -123,6 +129,9 @@ def export(source: Any, out: str | os.PathLike, *, to: str, overwrite: bool = Fa
     roughbrdf.output.OverwriteRefused: ...paint.xml exists; not overwriting it (pass overwrite=True)
     """
     target = target_name(to)
+    if target in ("lighttools", "zemax-abg"):
+        paths = _write_straylight(target, source, Path(out), channel, overwrite, options)
+        return ExportResult(target, paths, "wrote " + ", ".join(map(str, paths)))
     if target == "zemax":
         from .zemax import to_zemax
 
@@ -140,6 +149,63 @@ def export(source: Any, out: str | os.PathLike, *, to: str, overwrite: bool = Fa
         files = {base: (done.bsdf, done.note_lines())}
     text = "\n".join([done.summary(), *done.note_lines()])
     return ExportResult(target, _write_mitsuba(files, target, overwrite), text, done)
+
+
+def _channel_models(source: Any, channel: Any) -> list[tuple[str | None, Any, Any]]:
+    """``[(label, source, channel)]`` to write one file each (label None: the file named
+    ``out`` itself): a model or a per-incidence fit as it is; a fit or ``{channel: model}``
+    one per channel (or ``channel`` alone)."""
+    from ..fitting.result import FitResult
+
+    if isinstance(source, FitResult):
+        labels = [c.channel for c in source.channels]
+        if channel is not None or len(labels) == 1:
+            return [(None, source, channel)]
+        return [(lab, source, lab) for lab in labels]
+    if isinstance(source, dict) and source.get("per_incidence"):  # a saved per-incidence fit
+        return [(None, source, channel)]
+    if isinstance(source, dict):
+        labels = [str(k) for k in source]
+        if channel is not None:
+            if str(channel) not in labels:
+                raise ArgumentError("channel", f"not a channel of the fit ({', '.join(labels)})",
+                                    value=channel)
+            return [(None, source[str(channel)], None)]
+        if len(labels) == 1:
+            return [(None, next(iter(source.values())), None)]
+        return [(str(lab), m, None) for lab, m in source.items()]
+    return [(None, source, channel)]
+
+
+def _write_straylight(target: str, source: Any, out: Path, channel: Any, overwrite: bool,
+                      options: dict[str, Any]) -> list[Path]:
+    """The LightTools file(s) (:func:`~roughbrdf.export.lighttools.to_lighttools`) or the Zemax
+    ABg table(s) (:func:`~roughbrdf.export.abg_catalog.write_abg_catalog`), one per channel
+    (``<stem>_<channel><suffix>``); every target checked before the first is written."""
+    from ..output import refuse_existing
+
+    suffix = ".bsdf" if target == "lighttools" else ".txt"
+    base = out if out.suffix else out.with_suffix(suffix)
+    items = _channel_models(source, channel)
+    paths = [base if lab is None else base.with_name(f"{base.stem}_{_safe(lab)}{base.suffix}")
+             for lab, _, _ in items]
+    for p in paths:
+        refuse_existing(p, overwrite)
+    done = []
+    for (lab, obj, ch), path in zip(items, paths, strict=True):
+        if target == "lighttools":
+            from .lighttools import to_lighttools
+
+            done.append(to_lighttools(obj, path, channel=ch, overwrite=overwrite,
+                                      **options).path)
+        else:
+            from .abg_catalog import write_abg_catalog
+
+            opts = dict(options)
+            if lab is not None and "name" not in opts:  # one catalog name per channel
+                opts["name"] = _safe(f"{base.stem}_{lab}")[:31]
+            done.append(write_abg_catalog(obj, path, channel=ch, overwrite=overwrite, **opts))
+    return done
 
 
 def _safe(label: str) -> str:

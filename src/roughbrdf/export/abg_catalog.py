@@ -72,6 +72,8 @@ def abg_rows(source: Any, channel: str | int | None = None) -> tuple[list[AbgRow
     from ..integrate import albedo
 
     ch: str | None
+    if isinstance(source, dict) and source.get("per_incidence"):  # its saved fit.json
+        return _saved_rows(source, channel)
     if isinstance(source, PerIncidenceFit):
         ch = str(channel) if channel is not None else source.channels[0]
         if ch not in source.channels:
@@ -94,6 +96,25 @@ def abg_rows(source: Any, channel: str | int | None = None) -> tuple[list[AbgRow
         model, ch = source, None
     a, b, g = _abg_of(model)
     return [AbgRow(0.0, a, b, g, float(albedo(model, 0.0)))], ch
+
+
+def _saved_rows(doc: dict[str, Any], channel: str | int | None
+                ) -> tuple[list[AbgRow], str | None]:
+    """The kept rows of a per-incidence ``fit.json`` (:meth:`PerIncidenceFit.to_dict`)."""
+    if doc.get("model") != "abg":
+        raise ArgumentError("source", "the Zemax ABg catalog holds ABg fits only",
+                            value=doc.get("model"))
+    kept = [r for r in doc["rows"] if r["kept"]]
+    labels = list(kept[0]["channels"])
+    ch = str(channel) if channel is not None else labels[0]
+    if ch not in labels:
+        raise ArgumentError("channel", f"not a channel of the fit ({', '.join(labels)})",
+                            value=channel)
+    rows = [AbgRow(float(r["theta_i_deg"]), float(r["channels"][ch]["params"]["A"]),
+                   float(r["channels"][ch]["params"]["B"]),
+                   float(r["channels"][ch]["params"]["g"]), float(r["channels"][ch]["tis"]))
+            for r in kept]
+    return rows, ch
 
 
 def catalog_text(rows: list[AbgRow], name: str, wavelength_um: float | None,

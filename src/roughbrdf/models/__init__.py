@@ -1,5 +1,8 @@
 """Models: one module per published model, plus Lambertian, generic microfacet and sums.
 
+The stray-light scatter models of the optical codes are in :mod:`.straylight` (ABg,
+Harvey–Shack) and :mod:`.kcorr` (K-correlation / Rayleigh–Rice); ``docs/straylight.md``.
+
 ``base`` (the :class:`Model` class and its evaluation interface, the registry), ``parameters``
 (:class:`Parameter`), ``sum`` (:class:`SumModel`), ``factory`` (:func:`model` by name or
 ``"a+b"``, specs, and the naming a fit uses: :func:`as_model`, :func:`model_label`,
@@ -18,11 +21,13 @@ from .factory import (
     resolve_names,
     spec_text,
 )
+from .kcorr import KCorrelation
 from .lambertian import Lambertian
 from .microfacet import Microfacet
 from .oren_nayar import OrenNayar
 from .parameters import Parameter
 from .renhorn_boreman import RenhornBoreman2008
+from .straylight import ABg, HarveyShack
 from .torrance_sparrow import TorranceSparrow1967
 from .trowbridge_reitz import TrowbridgeReitz1975
 
@@ -41,7 +46,10 @@ __all__ = [
     "register",
     "resolve_names",
     "spec_text",
+    "ABg",
     "Coated",
+    "HarveyShack",
+    "KCorrelation",
     "Lambertian",
     "Microfacet",
     "OrenNayar",

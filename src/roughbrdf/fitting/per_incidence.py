@@ -199,7 +199,7 @@ def _at(meas: Measurement, theta_i: float) -> np.ndarray:
 def _errors(rows: list[IncidenceRow], chosen: list[int], meas: Measurement,
             channel: str) -> tuple[float, float]:
     """(worst relative TIS error, rms-log) of the rows ``chosen`` interpolated, at every
-    measured incidence of ``channel``."""
+    measured incidence of ``channel`` (on the samples each incidence's fit used)."""
     from ..integrate import albedo
 
     kept = [rows[k] for k in chosen]
@@ -214,9 +214,11 @@ def _errors(rows: list[IncidenceRow], chosen: list[int], meas: Measurement,
         own = r.tis[channel]
         # a row whose own TIS is 0 (no scatter): the absolute error stands in
         worst = max(worst, abs(tis - own) / own if own > 0 else abs(tis))
-        sel = _at(meas, r.theta_i)
-        x = meas.values[sel, col] * r.result[channel].scale
-        f = np.asarray(model.brdf(meas.theta_i[sel], meas.theta_r[sel], meas.phi[sel]))
+        # the samples the row's fit used (its fit domain: not the extrapolated ones it left out)
+        sub, fit = r.result.measurement, r.result[channel]
+        idx = fit.index
+        x = sub.values[idx, col] * fit.scale
+        f = np.asarray(model.brdf(sub.theta_i[idx], sub.theta_r[idx], sub.phi[idx]))
         ok = (x > 0) & (f > 0) & np.isfinite(f)  # ln needs both positive
         sq += float(np.sum(np.log(x[ok] / f[ok]) ** 2))
         n += int(ok.sum())

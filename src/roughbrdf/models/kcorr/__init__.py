@@ -3,7 +3,8 @@
 The stray-light codes' "K-correlation" model (FRED; Dittman, *Proc. SPIE* 6291 (2006)) is the
 first-order vector perturbation (Rayleigh–Rice) BRDF of a smooth rough interface with the
 ABC power spectral density of Church & Takacs, exactly NIST SCATMECH's
-``Microroughness_BRDF_Model`` with its ``ABC_PSD_Function`` (``docs/straylight.md``, "K-correlation"):
+``Microroughness_BRDF_Model`` with its ``ABC_PSD_Function`` (``docs/straylight.md``,
+"K-correlation"):
 
 * :mod:`.kernel`: the compiled Rayleigh–Rice Jones elements, the scalar kernel and drivers;
 * :mod:`.model`: :class:`KCorrelation` (registered as ``"k-correlation"``, aliases ``"kcorr"``,

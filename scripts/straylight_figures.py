@@ -7,7 +7,7 @@ incidences; the energy constraint keeps TIS <= 1), and ABg per incidence
 (:func:`roughbrdf.fitting.per_incidence.fit_per_incidence`); prints a Markdown table (the
 parameters, rms-log, the largest TIS over 0-89 deg) and draws the in-plane cuts (data points and
 model lines per measured incidence, log scale) into ``straylight_<file>.png``. The Mini-Diff
-paint needs ``../shared/data`` (or ``ROUGHBRDF_SHARED_DATA``); without it that file is skipped
+paints need ``../shared/data`` (or ``ROUGHBRDF_SHARED_DATA``); without it that file is skipped
 with a note.
 """
 
@@ -27,8 +27,11 @@ from roughbrdf.fitting.plausibility import EXPORT_INCIDENCES_DEG
 
 HERE = Path(__file__).resolve().parent
 SHARED = Path(os.environ.get("ROUGHBRDF_SHARED_DATA", HERE.parent.parent / "shared" / "data"))
-FILES = {"AnoBlack": (HERE.parent / "tests" / "data" / "zemax" / "AnoBlackNiTEonINVAR.bsdf", None),
-         "Aeroglaze": (HERE.parent / "tests" / "data" / "zemax" / "aeroglaze.bsdf", None),
+ZEMAX = HERE.parent / "tests" / "data" / "zemax"
+FILES = {"AnoBlack": (ZEMAX / "AnoBlackNiTEonINVAR.bsdf", None),
+         "Aeroglaze": (ZEMAX / "aeroglaze.bsdf", None),
+         "C2_Black": (SHARED / "minidiff" / "C2_Black.astm", "630nm"),
+         "C8_Silver": (SHARED / "minidiff" / "C8_Silver.astm", "630nm"),
          "C12_OliveDrab": (SHARED / "minidiff" / "C12_OliveDrab.astm", "630nm")}
 MODELS = ("abg", "harvey-shack")
 

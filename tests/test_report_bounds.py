@@ -104,7 +104,7 @@ def test_a_parameter_at_a_bound_has_no_stderr_in_the_report(bound_fit):
     fake = dataclasses.replace(fake, at_bound={"g": "upper"}, bounds={**c.bounds})
     text = dataclasses.replace(bound_fit, channels=[fake]).report()
     line = next(ln for ln in text.splitlines() if ln.strip().startswith("c "))
-    assert "+/- 5.43e+05 (> 1000%)" in line
+    assert "+/- 5.43e+05 1/deg (> 1000%)" in line  # TS67's c is per degree
 
 
 def test_percentages_are_never_absurd():

@@ -149,7 +149,7 @@ class Plausibility:
         peak = ", ".join(f"{t:g}: {r:.3g}" for t, r in zip(self.peak_theta_deg, self.peak_ratio,
                                                           strict=True))
         out = ["[[Plausibility]]",
-               f"    albedo by theta_i (deg): {alb}",
+               f"    albedo (TIS) by theta_i (deg): {alb}",
                f"    peak model/data by theta_i (deg): {peak or 'none'}"]
         if self.gains_energy:
             out.append(f"    GAINS ENERGY: albedo {self.max_albedo:.4g} > 1 at theta_i = "

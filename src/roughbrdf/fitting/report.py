@@ -192,14 +192,24 @@ def _angle_parameters(c: ChannelFit) -> set[str]:
     return {p.name for p in getattr(model, "parameters", ()) if p.unit == "rad"}
 
 
-def _variable(c: ChannelFit, name: str, val: float | None, angle: str | None) -> str:
-    """One parameter's line; ``angle`` is the unit of an angle parameter (else None)."""
+def _physical_units(c: ChannelFit) -> dict[str, str]:
+    """The units of the channel's parameters that have one other than an angle or ``1`` (the
+    stray-light codes' ``A`` in sr⁻¹, the PSD's ``A`` in µm⁴, TS67's ``c`` per degree)."""
+    model = getattr(c, "model", None)
+    return {p.name: p.unit for p in getattr(model, "parameters", ())
+            if p.unit not in ("", "1", "rad")}
+
+
+def _variable(c: ChannelFit, name: str, val: float | None, angle: str | None,
+              physical: str | None = None) -> str:
+    """One parameter's line; ``angle`` is the unit of an angle parameter (else None),
+    ``physical`` another unit to print beside the values (else None)."""
     def shown(v: float | None, digits: int = 6) -> str:
         if v is None or angle is None:
             return fmt(v, digits)
         return fmt(math.degrees(v) if angle == "deg" else v, digits)
 
-    unit = f" {angle}" if angle else ""
+    unit = f" {angle}" if angle else (f" {physical}" if physical else "")
     if name not in c.free:
         return "None (switched off)" if val is None else f"{shown(val, 7)}{unit} (fixed)"
     lo, hi = c.bounds[name]
@@ -216,8 +226,9 @@ def _variable(c: ChannelFit, name: str, val: float | None, angle: str | None) ->
 def _variables(c: ChannelFit, angles: str = "rad") -> list[str]:
     width = max(len(n) for n in [*c.params, "scale K"])
     lines = ["[[Variables]]"]
-    angular = _angle_parameters(c)
-    lines += [f"    {name:<{width}}: {_variable(c, name, val, angles if name in angular else None)}"
+    angular, units = _angle_parameters(c), _physical_units(c)
+    lines += [f"    {name:<{width}}: "
+              f"{_variable(c, name, val, angles if name in angular else None, units.get(name))}"
               for name, val in c.params.items()]
     if c.at_bound:
         names = ", ".join(c.at_bound)

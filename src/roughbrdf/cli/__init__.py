@@ -45,6 +45,7 @@ EXIT_INTERRUPTED = 130
 
 #: modules under roughbrdf.cli that register verbs (each defines register(app))
 VERBS = ["evaluate", "fit", "fit_batch", "compare", "export", "convert", "plot", "reproduce"]
+VERBS += ["explore"]  # roughbrdf explore: the web explorer (docs/explore.md)
 
 _APP: list[Any] = []
 

@@ -1,0 +1,232 @@
+"""The Dash application of ``roughbrdf explore``: the page (:mod:`.app_layout`) and its
+callbacks.
+
+Data flow (every step a Python callback on the server, all in one process):
+
+* a parameter's slider and typed field mirror each other (:func:`_sync`); the model callback
+  (:func:`_model`) rebuilds the model from the options and the typed fields
+  (:func:`~roughbrdf.explore.app_state.model_from_controls`), keeps the last good value of a
+  parameter whose typed value is outside its domain and says so under the controls, and stores
+  the model's ``to_dict()`` in ``model-store``;
+* the view callback (:func:`_views`) draws the open tab only, with
+  :mod:`roughbrdf.explore.figures`, from ``model-store``, the incidence (degrees on the page,
+  radians to the figures) and the view options; an error is one line in the tab;
+* "Fit" starts a :class:`~roughbrdf.explore.app_jobs.FitJob`, polled by an interval while it
+  runs; "Export" writes into the ``--out`` folder (:func:`~roughbrdf.explore.app_jobs.export_model`).
+
+The application serves its scripts and styles itself (``serve_locally=True``: the packages'
+own files, nothing from a CDN) and runs without Dash's dev tools.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from typing import Any
+
+import dash
+from dash import ALL, MATCH, Input, Output, State, ctx, html, no_update
+
+from .app_jobs import FitJob, evaluation, export_model
+from .app_layout import THETA_I, VIEWS, layout, parameter_controls
+from .app_state import Session, model_from_controls
+
+__all__ = ["build_app"]
+
+
+def _say(text: str) -> None:
+    """One line on the terminal (the server's stderr)."""
+    try:
+        print(text, file=sys.stderr, flush=True)
+    except (OSError, ValueError):  # stderr closed: the page still shows it
+        pass
+
+
+def _message(exc: BaseException) -> str:
+    from ..cli.common import error_message
+
+    return error_message(exc)
+
+
+class _OfflineDash(dash.Dash):
+    """Dash without the one address of the network its page names: the version check's
+    (only the dev tools use it; they are off) is removed from the page's config."""
+
+    def _config(self) -> dict[str, Any]:
+        config = super()._config()
+        config["dash_version_url"] = ""
+        config["disable_version_check"] = True
+        return config
+
+
+def build_app(session: Session) -> dash.Dash:
+    """The Dash application for ``session`` (serve its ``.server``, a Flask WSGI app)."""
+    app = _OfflineDash("roughbrdf.explore", serve_locally=True, title="roughbrdf explore",
+                    update_title=None, suppress_callback_exceptions=True, compress=False)
+    app.layout = layout(session)
+    if not session.error:
+        _controls_callbacks(app, session)
+        _view_callbacks(app, session)
+        _action_callbacks(app, session)
+    return app
+
+
+def _model_of(data: Any) -> Any:
+    import roughbrdf as rb
+
+    return None if not data else rb.model(data)
+
+
+def _controls_callbacks(app: dash.Dash, session: Session) -> None:
+    @app.callback(Output({"role": "slider", "name": MATCH}, "value"),
+                  Output({"role": "input", "name": MATCH}, "value"),
+                  Input({"role": "slider", "name": MATCH}, "value"),
+                  Input({"role": "input", "name": MATCH}, "value"),
+                  State({"role": "slider", "name": MATCH}, "min"),
+                  State({"role": "slider", "name": MATCH}, "max"),
+                  prevent_initial_call=True)
+    def _sync(slider: Any, typed: Any, lo: float, hi: float) -> tuple[Any, Any]:
+        trigger = ctx.triggered_id or {}
+        if trigger.get("role") == "slider":
+            return no_update, slider
+        if typed is None:  # an empty field (an optional part off): the slider stays
+            return no_update, no_update
+        return min(max(float(typed), lo), hi), no_update
+
+    @app.callback(Output("param-panel", "children"),
+                  Input({"role": "option", "name": ALL}, "value"),
+                  State({"role": "option", "name": ALL}, "id"),
+                  State("model-store", "data"), prevent_initial_call=True)
+    def _options(values: list[Any], ids: list[dict[str, str]], data: Any) -> Any:
+        model = _model_of(data) or session.model
+        try:
+            changed = model.with_params(**{i["name"]: v for i, v in zip(ids, values,
+                                                                       strict=True)})
+        except (ValueError, TypeError):  # refused combination: the model callback says why
+            return no_update
+        return parameter_controls(changed)
+
+    @app.callback(Output("model-store", "data"), Output("param-msg", "children"),
+                  Input({"role": "input", "name": ALL}, "value"),
+                  Input({"role": "option", "name": ALL}, "value"),
+                  State({"role": "input", "name": ALL}, "id"),
+                  State({"role": "option", "name": ALL}, "id"),
+                  State("model-store", "data"), prevent_initial_call=True)
+    def _model(values: list[Any], options: list[Any], ids: list[dict[str, str]],
+               option_ids: list[dict[str, str]], data: Any) -> tuple[Any, Any]:
+        base = _model_of(data) or session.model
+        if base is None:
+            return no_update, ""
+        typed = {i["name"]: v for i, v in zip(ids, values, strict=True)
+                 if i["name"] != THETA_I}
+        chosen = {i["name"]: v for i, v in zip(option_ids, options, strict=True)}
+        try:
+            model, bad = model_from_controls(base, typed, chosen)
+        except (ValueError, TypeError) as exc:
+            return no_update, f"not a model: {_message(exc)}"
+        lines = [f"{name}: {text}" for name, text in bad.items()]
+        return model.to_dict(), "\n".join(lines)
+
+
+def _incidence(values: list[Any], ids: list[dict[str, str]]) -> float:
+    """The incidence (radians) from the page's controls (degrees); 30 deg while empty."""
+    for i, v in zip(ids, values, strict=True):
+        if i["name"] == THETA_I and v is not None:
+            deg = float(v)
+            if not (math.isfinite(deg) and 0 <= deg < 90):
+                raise ValueError(f"incidence {deg:g} deg: give an angle in [0, 90) degrees")
+            return math.radians(deg)
+    return math.radians(30.0)
+
+
+def _figure(view: str, session: Session, model: Any, theta_i: float, quantity: str,
+            log: bool, channel: Any, mode: str) -> Any:
+    from . import figures
+
+    meas = session.measurement
+    if view == "lobe":
+        return figures.lobe_3d(model, theta_i, quantity=quantity, log=log)
+    if view == "cuts":
+        return figures.plane_cuts(model, meas, channel=channel, log=True)
+    if view == "maps":
+        return figures.hemisphere_maps(model, meas, theta_i, channel=channel)
+    if view == "albedo":
+        return figures.albedo_curve(model)
+    if view == "mueller":
+        return figures.mueller_maps(model, theta_i)
+    other = session.fit_models.get(str(channel)) if session.fit_models else None
+    return figures.compare_lobes(model, other if other is not None else session.model,
+                                 theta_i, mode=mode)
+
+
+def _view_callbacks(app: dash.Dash, session: Session) -> None:
+    views = [v for v, _, needs in VIEWS if session.model is not None or not needs]
+    outputs = [Output(f"g-{v}", "figure") for v in views]
+    outputs += [Output(f"msg-{v}", "children") for v in views]
+
+    @app.callback(*outputs,
+                  Input("view-tabs", "value"), Input("model-store", "data"),
+                  Input({"role": "input", "name": ALL}, "value"),
+                  Input("view-quantity", "value"), Input("view-log", "value"),
+                  Input("view-channel", "value"), Input("view-compare", "value"),
+                  State({"role": "input", "name": ALL}, "id"))
+    def _views(tab: str, data: Any, values: list[Any], quantity: str, log: list[str],
+               channel: Any, mode: str, ids: list[dict[str, str]]) -> list[Any]:
+        figs: list[Any] = [no_update] * len(views)
+        msgs: list[Any] = [no_update] * len(views)
+        if tab not in views:
+            return figs + msgs
+        k = views.index(tab)
+        try:
+            theta_i = _incidence(values, ids)
+            model = _model_of(data)
+            with evaluation():
+                figs[k] = _figure(tab, session, model, theta_i, quantity, bool(log), channel,
+                                  mode)
+            msgs[k] = ""
+        except Exception as exc:  # noqa: BLE001 - one line in the tab, and in the terminal
+            from ..models import NoMuellerMatrix
+
+            text = _message(exc) if not isinstance(exc, NoMuellerMatrix) else \
+                f"no Mueller matrix: {' '.join(str(exc).split())}"
+            msgs[k] = text
+            _say(f"explore: {tab}: {text}")
+        return figs + msgs
+
+
+def _action_callbacks(app: dash.Dash, session: Session) -> None:
+    jobs: dict[str, FitJob] = {}
+
+    @app.callback(Output("fit-poll", "disabled"), Output("fit-status", "children"),
+                  Output("fit-start", "disabled"), Output("fit-cancel", "disabled"),
+                  Output("fit-progress", "value"), Output("fit-report", "children"),
+                  Input("fit-start", "n_clicks"), Input("fit-cancel", "n_clicks"),
+                  Input("fit-poll", "n_intervals"), State("model-store", "data"),
+                  prevent_initial_call=True)
+    def _fit(start: Any, cancel: Any, poll: Any, data: Any) -> tuple[Any, ...]:
+        job = jobs.get("current")
+        trigger = ctx.triggered_id
+        if trigger == "fit-start" and (job is None or job.state != "running"):
+            model = _model_of(data)
+            if model is None or session.measurement is None:
+                return True, "needs a measurement and a model", False, True, "0", no_update
+            job = jobs["current"] = FitJob(model, session.measurement).start()
+        elif trigger == "fit-cancel" and job is not None:
+            job.cancel()
+        if job is None:
+            return True, "", False, True, "0", no_update
+        running = job.state == "running"
+        progress = f"{job.done / job.total if job.total else 1.0:.3f}"
+        return (not running, job.status(), running, not running, progress,
+                job.report if job.reports or not running else no_update)
+
+    @app.callback(Output("export-msg", "children"), Input("export-go", "n_clicks"),
+                  State("export-to", "value"), State("export-name", "value"),
+                  State("model-store", "data"), prevent_initial_call=True)
+    def _export(clicks: Any, to: str, name: str, data: Any) -> str:
+        try:
+            text = export_model(_model_of(data), session.out, name, to)
+        except Exception as exc:  # noqa: BLE001 - the page says why, nothing is written
+            text = f"not exported: {_message(exc)}"
+        _say(f"explore: {text.splitlines()[-1]}")
+        return text

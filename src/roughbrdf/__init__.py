@@ -22,13 +22,17 @@ import os as _os
 # Set here, at package import, so that it precedes the first compiled call whatever it is.
 _os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
+import sys as _sys  # noqa: E402
+import types as _types  # noqa: E402
 from typing import TYPE_CHECKING as _TYPE_CHECKING  # noqa: E402
 
 if _TYPE_CHECKING:  # for type checkers and IDEs; at run time the names load on first use
     from . import diffuse, distributions, fresnel, geometry, shadowing
     from .catalogue import fit_catalogue
+    from .explore.notebook import explore
     from .export import export_mitsuba, export_to, export_zemax
     from .fitting import FitOptions, FitResult, compare, fit
+    from .fitting.load import load_fit
     from .integrate import albedo, reciprocity_error
     from .io import read, write
     from .measurement import Measurement
@@ -42,6 +46,7 @@ __all__ = [
     "compare",
     "diffuse",
     "distributions",
+    "explore",
     "export_mitsuba",
     "export_to",
     "export_zemax",
@@ -51,6 +56,7 @@ __all__ = [
     "FitResult",
     "fresnel",
     "geometry",
+    "load_fit",
     "Measurement",
     "model",
     "Model",
@@ -68,6 +74,7 @@ _ATTRS = {
     "FitResult": "fitting",
     "fit": "fitting",
     "compare": "fitting",
+    "load_fit": "fitting.load",
     "fit_catalogue": "catalogue",
     "export_to": "export",
     "export_mitsuba": "export",
@@ -87,10 +94,40 @@ _ATTRS = {
 #: submodules reachable as attributes (``rb.geometry``) without importing them first: the public
 #: ones of ``__all__`` and those an eager ``import roughbrdf`` used to load as a side effect
 _SUBMODULES = frozenset({
-    "catalogue", "diffuse", "distributions", "export", "fresnel", "geometry", "shadowing",
-    "fitting", "integrate", "io", "measurement", "models", "mueller", "plot_mueller",
+    "catalogue", "diffuse", "distributions", "explore", "export", "fresnel", "geometry",
+    "shadowing", "fitting", "integrate", "io", "measurement", "models", "mueller", "plot_mueller",
     "polarization", "quantity", "registry", "special", "stokes",
 })
+
+
+class _ExplorePackage(_types.ModuleType):
+    """The subpackage :mod:`roughbrdf.explore`, callable: ``rb.explore(model_or_fit,
+    measurement)`` is :func:`roughbrdf.explore.notebook.explore` (the notebook explorer).
+
+    ``rb.explore`` names both the function and the subpackage: importing a submodule
+    (``import roughbrdf.explore.figures``) binds the subpackage as the package's attribute
+    ``explore``, which would hide a function of that name. The subpackage is therefore made
+    callable instead (:class:`_Package` swaps its class when it is bound), so that
+    ``rb.explore(...)`` and ``rb.explore.figures`` both work whatever was imported first.
+    """
+
+    def __call__(self, *args, **kwargs):
+        from .explore.notebook import explore
+
+        return explore(*args, **kwargs)
+
+
+class _Package(_types.ModuleType):
+    """This package's module type: binds the subpackage ``explore`` callable
+    (:class:`_ExplorePackage`)."""
+
+    def __setattr__(self, name: str, value: object) -> None:
+        if name == "explore" and type(value) is _types.ModuleType:
+            value.__class__ = _ExplorePackage
+        super().__setattr__(name, value)
+
+
+_sys.modules[__name__].__class__ = _Package
 
 
 def __getattr__(name: str):
@@ -101,6 +138,8 @@ def __getattr__(name: str):
         value = getattr(importlib.import_module(f"{__name__}.{_ATTRS[name]}"), name)
     elif name in _SUBMODULES:
         value = importlib.import_module(f"{__name__}.{name}")
+        if name == "explore" and type(value) is _types.ModuleType:  # bound before the swap
+            value.__class__ = _ExplorePackage
     else:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     globals()[name] = value

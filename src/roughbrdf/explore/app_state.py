@@ -102,17 +102,17 @@ def load_session(file: str | None = None, *, fit_dir: str | None = None,
     from ..cli.common import cli_model, error_message
 
     session = Session(out=Path(out).resolve() if out else None)
+    labels = [f"fit {fit_dir}"] * (fit_dir is not None) + [str(file)] * (file is not None) \
+        + [str(model)] * (model is not None)
+    session.label = " - ".join(labels) or session.label
     try:
         if fit_dir is not None:
             session.fit_models, session.measurement, session.fit_report = _fit_inputs(fit_dir)
-            session.label = f"fit {fit_dir}"
             session.model = next(iter(session.fit_models.values()))
         if file is not None:
             session.measurement = rb.read(file)
-            session.label = str(file)
         if model is not None:
             session.model = cli_model(model, params)
-            session.label += f" - {model}" if session.label != "roughbrdf explore" else ""
     except Exception as exc:  # noqa: BLE001 - every failure is the page's one message
         session.error = error_message(exc, {"format": "--format", "quantity": "--quantity"})
     return session

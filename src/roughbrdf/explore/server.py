@@ -19,6 +19,7 @@ from __future__ import annotations
 import errno
 import logging
 import os
+import socket
 import sys
 import threading
 from typing import Any
@@ -105,10 +106,35 @@ def bind(app: WSGIApp, *, host: str | None = None, port: int = 0,
         return holder["guard"](environ, start_response)
 
     logging.getLogger("werkzeug").setLevel(logging.ERROR)  # no line per request
+    sock = _listen(host, port)
+    try:  # Werkzeug serves the socket bound here (its own bind exits the process on errors)
+        wsgi = make_server(host, int(sock.getsockname()[1]), guarded, threaded=True,
+                           fd=sock.fileno())
+    finally:
+        sock.close()  # Werkzeug holds its own duplicate of the descriptor
+    bound = int(wsgi.socket.getsockname()[1])
+    holder["guard"] = Guard(app, token=token, host=host, port=bound)
+    return Server(wsgi, host, bound, token)
+
+
+def _listen(host: str, port: int) -> socket.socket:
+    """A listening TCP socket on ``host``:``port``; ``ValueError`` naming the option at
+    fault."""
     try:
-        wsgi = make_server(host, port, guarded, threaded=True)
+        family, kind, proto, _, address = socket.getaddrinfo(host, port,
+                                                             type=socket.SOCK_STREAM)[0]
+    except (socket.gaierror, UnicodeError) as exc:
+        raise ValueError(f"--host {host!r}: not an address of this machine ({exc})") from None
+    sock = socket.socket(family, kind, proto)
+    try:
+        # SO_REUSEADDR as every server sets it: a port left in TIME_WAIT by the last run can be
+        # taken again; on Linux it never takes a port another socket listens on
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        sock.bind(address)
+        sock.listen(128)
     except OSError as exc:
-        if exc.errno == errno.EADDRINUSE or "in use" in str(exc).lower():
+        sock.close()
+        if exc.errno == errno.EADDRINUSE:
             raise ValueError(f"--port {port}: the port is already in use on {host} (another "
                              "program listens there); choose another --port, or leave it out "
                              "to take a free one") from None
@@ -117,11 +143,7 @@ def bind(app: WSGIApp, *, host: str | None = None, port: int = 0,
                              "need privileges)") from None
         raise ValueError(f"--host {host!r}: cannot listen on this address "
                          f"({exc.strerror or exc})") from None
-    except SystemExit:  # werkzeug exits on a busy port in some versions: make it an error
-        raise ValueError(f"--port {port}: the port is already in use on {host}") from None
-    bound = int(wsgi.socket.getsockname()[1])
-    holder["guard"] = Guard(app, token=token, host=host, port=bound)
-    return Server(wsgi, host, bound, token)
+    return sock
 
 
 def exposure_note(host: str) -> str:

@@ -209,6 +209,12 @@ class Measurement:
         return (f"<Measurement {self.n_samples} samples x {len(self.channels)} channels "
                 f"{self.channels}, {self.quantity}, file={self.meta.get('file')!r}>")
 
+    def _repr_html_(self) -> str:
+        """Jupyter's rich display (:func:`roughbrdf.html_repr.measurement_html`)."""
+        from .html_repr import measurement_html
+
+        return measurement_html(self)
+
     # ------------------------------------------------------------------------------------------
     # size and provenance
     # ------------------------------------------------------------------------------------------

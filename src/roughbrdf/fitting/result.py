@@ -380,6 +380,12 @@ class FitResult:
     def __str__(self) -> str:
         return self.report()
 
+    def _repr_html_(self) -> str:
+        """Jupyter's rich display (:func:`roughbrdf.html_repr.fit_html`)."""
+        from ..html_repr import fit_html
+
+        return fit_html(self)
+
     def plot_data(self, channel: int | str = 0) -> tuple[Model, Measurement]:
         """The fitted model and the fitted samples of one channel on the model's absolute scale.
 

@@ -432,6 +432,13 @@ class Model:
         args = ", ".join(f"{k}={v!r}" for k, v in {**self._options, **self._values}.items())
         return f"rb.model({self.name!r}, {args})"
 
+    def _repr_html_(self) -> str:
+        """Jupyter's rich display: name, reference, parameters, options
+        (:func:`roughbrdf.html_repr.model_html`; a sum, one block per component)."""
+        from ..html_repr import model_html
+
+        return model_html(self)
+
 
 def require_index(model: Model) -> None:
     """Raise :class:`~roughbrdf.errors.ArgumentError` naming ``n`` for a model built with

@@ -227,3 +227,23 @@ def test_nan_stderr_stays_nan(saved, tmp_path):
     assert math.isnan(back[0].stderr[free])
     fixed = [k for k in back[0].params if k not in back[0].free]
     assert all(back[0].stderr[k] is None for k in fixed)
+
+
+@pytest.mark.parametrize("options", [{"aperture": 0.02}, {"joint": True, "shared": ["e"]}])
+def test_two_channels_with_an_aperture_or_joint(tmp_path, options):
+    # two channels of a CSV file (synthetic TR75, one e, two rho_L): the fit's aperture and
+    # joint summary come back with it, and its predictions per channel
+    g = np.radians(np.mgrid[10:61:25, 0:81:10, 0:181:45].reshape(3, -1))
+    truth = rb.model("tr75", e=0.3, rho_L=0.1)
+    v = np.stack([truth.brdf(*g), truth.with_params(rho_L=0.05).brdf(*g)], axis=1)
+    rb.write(rb.Measurement(*g, v, channels=["465nm", "550nm"]), tmp_path / "syn.csv")
+    res = rb.fit(truth, rb.read(tmp_path / "syn.csv"), starts=1, progress=False, **options)
+    res.save(tmp_path / "fit", plots=False)
+    back = rb.load_fit(tmp_path / "fit")
+    assert json.loads(back.to_json()) == json.loads(res.to_json())
+    assert back.aperture == res.aperture and back.options == res.options
+    for ch in ("465nm", "550nm"):
+        np.testing.assert_allclose(back.predict(0.3, [0.2, 0.5], 0.0, channel=ch),
+                                   res.predict(0.3, [0.2, 0.5], 0.0, channel=ch), rtol=1e-12)
+        np.testing.assert_allclose(back[ch].residual, res[ch].residual, rtol=1e-10,
+                                   atol=1e-14)

@@ -12,7 +12,8 @@ Data flow (every step a Python callback on the server, all in one process):
   :mod:`roughbrdf.explore.figures`, from ``model-store``, the incidence (degrees on the page,
   radians to the figures) and the view options; an error is one line in the tab;
 * "Fit" starts a :class:`~roughbrdf.explore.app_jobs.FitJob`, polled by an interval while it
-  runs; "Export" writes into the ``--out`` folder (:func:`~roughbrdf.explore.app_jobs.export_model`).
+  runs; "Export" writes into the ``--out`` folder
+  (:func:`~roughbrdf.explore.app_jobs.export_model`).
 
 The application serves its scripts and styles itself (``serve_locally=True``: the packages'
 own files, nothing from a CDN) and runs without Dash's dev tools.
@@ -25,7 +26,7 @@ import sys
 from typing import Any
 
 import dash
-from dash import ALL, MATCH, Input, Output, State, ctx, html, no_update
+from dash import ALL, MATCH, Input, Output, State, ctx, no_update
 
 from .app_jobs import FitJob, evaluation, export_model
 from .app_layout import THETA_I, VIEWS, layout, parameter_controls
@@ -62,7 +63,8 @@ class _OfflineDash(dash.Dash):
 def build_app(session: Session) -> dash.Dash:
     """The Dash application for ``session`` (serve its ``.server``, a Flask WSGI app)."""
     app = _OfflineDash("roughbrdf.explore", serve_locally=True, title="roughbrdf explore",
-                    update_title=None, suppress_callback_exceptions=True, compress=False)
+                    update_title=None,  # type: ignore[arg-type]
+                        suppress_callback_exceptions=True, compress=False)
     app.layout = layout(session)
     if not session.error:
         _controls_callbacks(app, session)
@@ -99,6 +101,8 @@ def _controls_callbacks(app: dash.Dash, session: Session) -> None:
                   State("model-store", "data"), prevent_initial_call=True)
     def _options(values: list[Any], ids: list[dict[str, str]], data: Any) -> Any:
         model = _model_of(data) or session.model
+        if model is None:  # no model: no options either
+            return no_update
         try:
             changed = model.with_params(**{i["name"]: v for i, v in zip(ids, values,
                                                                        strict=True)})
@@ -154,9 +158,11 @@ def _figure(view: str, session: Session, model: Any, theta_i: float, quantity: s
         return figures.albedo_curve(model)
     if view == "mueller":
         return figures.mueller_maps(model, theta_i)
+    # B: the fitted model of the channel (--fit, or the last "Fit"), else the starting model
     other = session.fit_models.get(str(channel)) if session.fit_models else None
-    return figures.compare_lobes(model, other if other is not None else session.model,
-                                 theta_i, mode=mode)
+    other = other if other is not None else session.model
+    return figures.compare_lobes(model, other if other is not None else model, theta_i,
+                                 mode=mode)
 
 
 def _view_callbacks(app: dash.Dash, session: Session) -> None:
@@ -185,7 +191,7 @@ def _view_callbacks(app: dash.Dash, session: Session) -> None:
                                   mode)
             msgs[k] = ""
         except Exception as exc:  # noqa: BLE001 - one line in the tab, and in the terminal
-            from ..models import NoMuellerMatrix
+            from ..models.base import NoMuellerMatrix
 
             text = _message(exc) if not isinstance(exc, NoMuellerMatrix) else \
                 f"no Mueller matrix: {' '.join(str(exc).split())}"
@@ -216,6 +222,8 @@ def _action_callbacks(app: dash.Dash, session: Session) -> None:
         if job is None:
             return True, "", False, True, "0", no_update
         running = job.state == "running"
+        if job.state == "finished":  # the compare view shows the new fit beside the model
+            session.fit_models.update(job.models)
         progress = f"{job.done / job.total if job.total else 1.0:.3f}"
         return (not running, job.status(), running, not running, progress,
                 job.report if job.reports or not running else no_update)

@@ -149,7 +149,7 @@ def _tabs(session: Session) -> dcc.Tabs:
             dcc.Graph(id=f"g-{value}", style={"height": "70vh"},
                       config={"displaylogo": False}),
         ]))
-    first = tabs[0].value if tabs else None
+    first = next((v for v, _, needs in VIEWS if has_model or not needs), None)
     return dcc.Tabs(id="view-tabs", value=first, children=tabs)
 
 

@@ -116,6 +116,15 @@ class _ExplorePackage(_types.ModuleType):
 
         return explore(*args, **kwargs)
 
+    @property
+    def __signature__(self):
+        """The signature of :func:`~roughbrdf.explore.notebook.explore` (``inspect``, IDEs)."""
+        import inspect
+
+        from .explore.notebook import explore
+
+        return inspect.signature(explore)
+
 
 class _Package(_types.ModuleType):
     """This package's module type: binds the subpackage ``explore`` callable

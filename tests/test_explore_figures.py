@@ -216,7 +216,7 @@ def test_cuts_of_relative_data_scale_the_model_by_k():
     np.testing.assert_allclose(v["y"], TR75.brdf(RAD(30.0), tr, ph) / k, rtol=1e-12)
     assert "1/K = 3" in fig.layout.title.text
     r = F.figure_values(fig)["residual θi = 30° (in-plane)"]["y"]
-    np.testing.assert_allclose(r, math.log(3.0 * k), rtol=1e-9)  # ln(x / (f/K)) = ln(3 K)
+    np.testing.assert_allclose(r, math.log(3.0 * k), rtol=1e-9, atol=1e-12)  # ln(3 K)
 
 
 def test_cuts_bad_inputs_name_the_argument():
@@ -410,3 +410,50 @@ def test_import_roughbrdf_loads_neither_plotly_nor_dash():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
     assert out.stdout.strip() == "[]"
+
+
+# ---------------------------------------------------------------------------------------------
+# non-finite data, n-dimensional options, a real file
+# ---------------------------------------------------------------------------------------------
+def test_nan_and_negative_data_are_gaps_not_errors():
+    meas = _measurement(TR75)
+    meas.values[0, 0] = np.nan  # theta_i 30, theta_r 0 (in both cuts)
+    meas.values[1, 0] = -1.0  # theta_i 30, theta_r 10, phi 0: no log ratio
+    vals = F.figure_values(F.plane_cuts(TR75, meas, n=5))
+    d, r = vals["data θi = 30° (in-plane)"], vals["residual θi = 30° (in-plane)"]
+    assert np.isnan(d["y"]).sum() == 1 and np.isnan(r["y"]).sum() == 2
+    assert np.isfinite(r["y"]).sum() == d["y"].size - 2
+    maps = F.figure_values(F.hemisphere_maps(TR75, meas, RAD(30.0), resolution=5))
+    ratio = maps["data/model"]
+    assert np.isnan(ratio["value"]).sum() == 1 and ratio["value"][1] < 0  # as measured
+    assert np.isnan(ratio["color"]).sum() == 2  # log10 colour: none for NaN and ratio <= 0
+
+
+def test_cuts_take_incidences_of_any_shape():
+    fig = F.plane_cuts(LAMB, incidences=np.array([[0.1], [0.2]]), n=5)
+    assert len(fig.data) == 4  # two incidences x two cuts
+
+
+def test_side_by_side_lobes_share_one_scale():
+    fig = F.compare_lobes(TR75, LAMB, 0.4, mode="side", resolution=7)
+    assert fig.layout.scene.xaxis.range == fig.layout.scene2.xaxis.range
+    surfaces = [t for t in fig.data if t.type == "surface"]
+    assert surfaces[0].cmax == surfaces[1].cmax and surfaces[0].cmin == surfaces[1].cmin
+
+
+def test_a_real_files_points_are_its_values(shared_data):
+    meas = rb.read(shared_data / "minidiff" / "C2_Black.astm")
+    fig = F.plane_cuts(TR75, meas, channel="630nm", n=11)
+    vals = F.figure_values(fig)
+    name = next(n for n in vals if n.startswith("data ") and n.endswith("(in-plane)"))
+    d = vals[name]
+    j = meas.channel_index("630nm")
+    for k in (0, d["y"].size // 2, -1):  # each drawn point is one sample of the file
+        hit = ((np.abs(np.degrees(meas.theta_i) - d["theta_i_deg"][k]) < 1e-9)
+               & (np.abs(np.degrees(meas.theta_r) - d["theta_r_deg"][k]) < 1e-9)
+               & (np.abs(np.degrees(meas.phi) - d["phi_deg"][k]) < 1e-9))
+        assert hit.sum() >= 1
+        assert d["y"][k] in meas.values[hit, j]
+    tr, ph = _angles(d)
+    np.testing.assert_allclose(d["model"], TR75.brdf(RAD(d["theta_i_deg"]), tr, ph),
+                               rtol=1e-12)

@@ -134,12 +134,21 @@ def custom(fields: Sequence[str], *columns: ArrayLike) -> tuple[np.ndarray, dict
 
 
 def log_ticks(lo: float, hi: float) -> dict[str, Any]:
-    """Colour-bar ticks for colours that are ``log10`` of a value: the powers of ten in
-    ``[lo, hi]`` (decades) written as the values themselves."""
-    if not (math.isfinite(lo) and math.isfinite(hi)):
+    """Colour-bar ticks for colours that are ``log10`` of a value, written as the values:
+    1, 2, 5 times the powers of ten in ``[lo, hi]`` (decades), or only the powers of ten when
+    the range spans more than 3 decades.
+
+    Examples
+    --------
+    >>> log_ticks(-1.2, 0.5)["ticktext"]
+    ['0.1', '0.2', '0.5', '1', '2']
+    """
+    if not (math.isfinite(lo) and math.isfinite(hi)) or hi < lo:
         return {}
-    k = np.arange(math.ceil(lo), math.floor(hi) + 1)
-    return {"tickvals": k.tolist(), "ticktext": [f"{10.0 ** v:.0e}" for v in k]}
+    steps = (1.0,) if hi - lo > 3 else (1.0, 2.0, 5.0)
+    vals = [10.0 ** k * m for k in range(math.floor(lo), math.ceil(hi) + 1) for m in steps]
+    vals = [v for v in vals if lo <= math.log10(v) <= hi]
+    return {"tickvals": [math.log10(v) for v in vals], "ticktext": [f"{v:.3g}" for v in vals]}
 
 
 def disk_grid(n: int, coords: str = "cosines") -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -115,6 +115,7 @@ def _surface(grid: LobeGrid, name: str, log: bool, floor: float, quantity: Quant
     return go.Surface(
         x=r * st * np.cos(grid.phi), y=r * st * np.sin(grid.phi), z=r * np.cos(grid.theta_r),
         surfacecolor=r, customdata=cd, meta=meta, name=name, colorscale=colorscale,
+        showlegend=True,
         scene=scene, colorbar=colorbar,
         hovertemplate=f"{name}<br>{HOVER_ANGLES}<br>{label.split(' [')[0]} = "
                       f"%{{customdata[2]:.4g}} {SR}<extra></extra>", **kw)
@@ -142,13 +143,22 @@ def _markers(grid: LobeGrid, theta_i: float, log: bool, floor: float, tag: str,
     return out
 
 
-def _scene(log: bool, floor: float, quantity: Quantity) -> dict[str, Any]:
+def _scene(log: bool, floor: float, quantity: Quantity, reach: float | None = None
+           ) -> dict[str, Any]:
+    """A scene's axes (titles with units); with ``reach`` fixed ranges, the same for every
+    scene of a figure so that side-by-side lobes are drawn to one scale."""
     unit = f"decades above {floor:.3g} {SR}" if log else f"{SR}"
     q = "f_r" if quantity is Quantity.BRDF else "f_r cos θr"
-    return {"xaxis": {"title": {"text": f"x = {q} sin θr cos φ [{unit}] (φ = 0°: specular →)"}},
-            "yaxis": {"title": {"text": f"y = {q} sin θr sin φ [{unit}]"}},
-            "zaxis": {"title": {"text": f"z = {q} cos θr [{unit}] (normal)"}},
-            "aspectmode": "data", "camera": {"eye": {"x": 0.2, "y": -1.8, "z": 0.9}}}
+    axes: dict[str, Any] = {
+        "xaxis": {"title": {"text": f"x = {q} sin θr cos φ [{unit}] (φ = 0°: specular →)"}},
+        "yaxis": {"title": {"text": f"y = {q} sin θr sin φ [{unit}]"}},
+        "zaxis": {"title": {"text": f"z = {q} cos θr [{unit}] (normal)"}},
+        "aspectmode": "data", "camera": {"eye": {"x": 0.2, "y": -1.8, "z": 0.9}}}
+    if reach is not None:
+        for k, lo in (("xaxis", -reach), ("yaxis", -reach), ("zaxis", 0.0)):
+            axes[k]["range"] = [lo, reach]
+        axes.update(aspectmode="manual", aspectratio={"x": 2, "y": 2, "z": 1})
+    return axes
 
 
 def _reach(grids: list[LobeGrid], log: bool, floor: float) -> float:
@@ -224,7 +234,8 @@ def lobe_3d(model: Model, theta_i: float, *, quantity: str = "brdf", log: bool =
                                                 + (" (log radius)" if log else "") + pol,
                                                 model, label=label, theta_i=t,
                                                 channel=channel)},
-                      scene=_scene(log, floor, q), margin={"l": 0, "r": 0, "t": 50, "b": 0})
+                      scene=_scene(log, floor, q), margin={"l": 0, "r": 0, "t": 50, "b": 0},
+                      legend={"x": 0.01, "y": 0.99})
     return fig
 
 
@@ -263,10 +274,18 @@ def compare_lobes(model_a: Model, model_b: Model, theta_i: float, *, mode: str =
                         subplot_titles=[f"A: {names[0]}", f"B: {names[1]}"]) if side \
         else go.Figure()
     scenes = ("scene", "scene2") if side else ("scene", "scene")
+    top = reach / 1.15  # the largest radius of both: one colour scale
     for i, (grid, tag, cs) in enumerate(zip(grids, "AB", ("Viridis", "Reds"), strict=True)):
-        extra: dict[str, Any] = {"opacity": 0.55} if (i == 1 and not side) else {}
-        extra["colorbar"] = {"x": 1.0 + 0.12 * i, "len": 0.8,
-                             "title": {"text": tag + (" [decades]" if log else f" [{SR}]")}}
+        # side by side: one colour scale and bar; overlaid: B translucent in its own colours
+        extra: dict[str, Any] = {"cmin": 0.0, "cmax": top}  # radii are >= 0
+        if side:
+            extra.update(showscale=i == 0)
+            cs = "Viridis"
+        else:
+            extra["colorbar"] = {"x": 1.0 + 0.12 * i, "len": 0.8,
+                                 "title": {"text": tag + (" [decades]" if log else f" [{SR}]")}}
+            if i == 1:
+                extra["opacity"] = 0.55
         fig.add_trace(_surface(grid, f"{tag}: {names[i]}", log, floor, q, cs, scenes[i],
                                **extra))
         for tr in _markers(grid, t, log, floor, f" ({tag})", scenes[i], reach):
@@ -274,8 +293,8 @@ def compare_lobes(model_a: Model, model_b: Model, theta_i: float, *, mode: str =
     what = f"{quantity_label(q).split(' [')[0]} lobes, {mode}" + (" (log radius)" if log else "")
     fig.update_layout(title={"text": title_text(what, label=f"{names[0]} vs {names[1]}",
                                                 theta_i=t)},
-                      margin={"l": 0, "r": 0, "t": 60, "b": 0})
-    fig.update_layout(scene=_scene(log, floor, q))
+                      margin={"l": 0, "r": 0, "t": 60, "b": 0}, legend={"x": 0.01, "y": 0.99})
+    fig.update_layout(scene=_scene(log, floor, q, reach if side else None))
     if side:
-        fig.update_layout(scene2=_scene(log, floor, q))
+        fig.update_layout(scene2=_scene(log, floor, q, reach))
     return fig

@@ -69,7 +69,7 @@ def _marks(fig: go.Figure, theta_i: float, coords: str, col: int, first: bool) -
     for what, phi, symbol in (("specular", 0.0, "cross-thin"), ("retro", math.pi, "x-thin")):
         x, y = disk_position(theta_i, phi, coords)
         fig.add_trace(go.Scatter(
-            x=[float(x)], y=[float(y)], mode="markers", name=f"{what} ({col})",
+            x=[float(x)], y=[float(y)], mode="markers", name=what,
             legendgroup=what, showlegend=first, marker={"symbol": symbol, "size": 12,
                                                         "color": "cyan",
                                                         "line": {"width": 2, "color": "cyan"}},
@@ -78,6 +78,7 @@ def _marks(fig: go.Figure, theta_i: float, coords: str, col: int, first: bool) -
 
 
 def _disk_axes(fig: go.Figure, n_cols: int, coords: str, rows: int = 1) -> None:
+    """Equal-aspect disks (the panel shrinks, the range stays) with the rings."""
     xt, yt = disk_axis_titles(coords)
     edge = 1.05 if coords == "cosines" else 95.0
     shapes: list[dict[str, Any]] = []
@@ -85,8 +86,8 @@ def _disk_axes(fig: go.Figure, n_cols: int, coords: str, rows: int = 1) -> None:
         sfx = "" if i == 0 else str(i + 1)
         shapes += disk_rings(coords, f"x{sfx}", f"y{sfx}")
         fig.layout[f"yaxis{sfx}"].update(scaleanchor=f"x{sfx}", scaleratio=1,
-                                         range=[-edge, edge])
-        fig.layout[f"xaxis{sfx}"].update(range=[-edge, edge])
+                                         range=[-edge, edge], constrain="domain")
+        fig.layout[f"xaxis{sfx}"].update(range=[-edge, edge], constrain="domain")
     fig.update_layout(shapes=shapes)
     fig.update_xaxes(title_text=xt, row=rows, col=1)
     fig.update_yaxes(title_text=yt, row=rows, col=1)
@@ -150,7 +151,7 @@ def hemisphere_maps(model: Model | None = None, measurement: Any = None,
     >>> import roughbrdf as rb
     >>> fig = hemisphere_maps(rb.model("lambertian", rho=0.5), theta_i=0.2, resolution=5)
     >>> [t.name for t in fig.data]
-    ['model', 'specular (1)', 'retro (1)']
+    ['model', 'specular', 'retro']
     >>> round(float(fig.data[0].customdata[2, 2, 2]), 6)       # the centre: rho/pi
     0.159155
     """
@@ -212,17 +213,21 @@ def _colour_axes(fig: go.Figure, traces: list[tuple[str, Any]], log: bool, q: Qu
                  relative: bool) -> None:
     """One colour scale for data and model, a diverging one (log10, centred on 1) for the
     ratio; colour bars with units."""
-    lo, hi = math.inf, -math.inf
+    parts = []
     for name, tr in traces:
-        if name == "data/model":
-            continue
-        c = np.asarray(tr.z if name == "model" else tr.marker.color, dtype=float)
-        if np.isfinite(c).any():
-            lo, hi = min(lo, float(np.nanmin(c))), max(hi, float(np.nanmax(c)))
+        if name != "data/model":
+            c = np.asarray(tr.z if name == "model" else tr.marker.color, dtype=float).ravel()
+            parts.append(c[np.isfinite(c)])
+    c = np.concatenate(parts) if parts else np.array([])
+    lo, hi = (math.inf, -math.inf) if c.size == 0 else (float(c.min()), float(c.max()))
+    if c.size > 20:
+        # the 99.5th percentile: a model diverging at the horizon (TR75) must not set the
+        # scale for the whole disk; the few values above it saturate
+        hi = float(np.percentile(c, 99.5))
     if log and math.isfinite(hi):  # at most 4 decades: a few tiny values must not wash it out
         lo = max(lo, hi - 4.0)
     label = "relative value [1]" if relative else quantity_label(q)
-    bar: dict[str, Any] = {"title": {"text": label}, "x": 1.02, "len": 0.9}
+    bar: dict[str, Any] = {"title": {"text": label, "side": "right"}, "x": 1.02, "len": 0.9}
     if log:
         bar.update(log_ticks(lo, hi))
     axis: dict[str, Any] = {"colorscale": "Magma", "colorbar": bar}
@@ -230,7 +235,8 @@ def _colour_axes(fig: go.Figure, traces: list[tuple[str, Any]], log: bool, q: Qu
         axis.update(cmin=lo, cmax=hi)
     fig.update_layout(coloraxis=axis)
     if any(name == "data/model" for name, _ in traces):
-        ratio_bar = {"title": {"text": "data / model [1]"}, "x": 1.12, "len": 0.9,
+        ratio_bar = {"title": {"text": "data / model [1]", "side": "right"}, "x": 1.12,
+                     "len": 0.9,
                      "tickvals": [-1, -0.5, -0.3, 0, 0.3, 0.5, 1],
                      "ticktext": ["0.1", "0.32", "0.5", "1", "2", "3.2", "10"]}
         fig.update_layout(coloraxis2={"colorscale": "RdBu_r", "cmin": -1.0, "cmax": 1.0,
@@ -289,6 +295,7 @@ def mueller_maps(model: Model, theta_i: float, *, basis: str = "psps", resolutio
                                    "coloraxis", SR, "m00"), row=i + 1, col=j + 1)
     fig.add_trace(_heatmap(axis, tr, ph, dl, m00, "DoLP", "coloraxis2", SR, "m00"),
                   row=1, col=5)
+    _marks(fig, t, coords, 5, True)
     _mueller_axes(fig, coords)
     fig.update_layout(
         coloraxis={"colorscale": "RdBu_r", "cmin": -1, "cmax": 1,
@@ -311,8 +318,9 @@ def _mueller_axes(fig: go.Figure, coords: str) -> None:
         sfx = key[len("xaxis"):]
         shapes += disk_rings(coords, f"x{sfx}", f"y{sfx}")
         fig.layout[f"yaxis{sfx}"].update(scaleanchor=f"x{sfx}", scaleratio=1,
-                                         range=[-edge, edge], showticklabels=False)
-        fig.layout[key].update(range=[-edge, edge], showticklabels=False)
+                                         range=[-edge, edge], showticklabels=False,
+                                         constrain="domain")
+        fig.layout[key].update(range=[-edge, edge], showticklabels=False, constrain="domain")
     fig.update_layout(shapes=shapes)
     xt, yt = disk_axis_titles(coords)
     fig.update_xaxes(title_text=xt, showticklabels=True, row=4, col=1)

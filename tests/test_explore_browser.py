@@ -251,6 +251,26 @@ def test_a_model_alone_draws_every_view_and_follows_its_parameters(
                           np.radians(lobe["phi_deg"]))
     ok = np.isfinite(expected)
     np.testing.assert_allclose(lobe["value"][ok], expected[ok], rtol=1e-12)
+    # the slider: its top end (the key End) is alpha's upper search bound, mirrored in the
+    # typed field and drawn
+    from selenium.webdriver.common.keys import Keys
+
+    top = {p.name: p for p in model.parameters}["alpha"].bounds[1]
+    browser.find_element("css selector", "[id='{\"name\":\"alpha\",\"role\":\"slider\"}'] "
+                                         "[role=slider]").send_keys(Keys.END)
+    _wait(browser, "return document.getElementById('{\"name\":\"alpha\",\"role\":\"input\"}')"
+                   ".value === arguments[0]", f"{top:g}", what="the typed field following")
+    steep = rb.model("microfacet", alpha=top, n=1.5)
+    give_up = time.monotonic() + HANG
+    while time.monotonic() < give_up:
+        lobe = _values(browser, "g-lobe")["microfacet"]
+        expected = steep.brdf(math.radians(50.0), np.radians(lobe["theta_r_deg"]),
+                              np.radians(lobe["phi_deg"]))
+        ok = np.isfinite(expected)
+        if np.allclose(lobe["value"][ok], expected[ok], rtol=1e-12):
+            break
+        time.sleep(0.1)
+    np.testing.assert_allclose(lobe["value"][ok], expected[ok], rtol=1e-12)
     # a typed value outside the parameter's domain: a message, the model kept
     _type(browser, "alpha", "-1")
     text = _wait(browser, "return document.getElementById('param-msg').textContent",

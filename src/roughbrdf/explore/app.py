@@ -128,19 +128,31 @@ def _controls_callbacks(app: dash.Dash, session: Session) -> None:
             model, bad = model_from_controls(base, typed, chosen)
         except (ValueError, TypeError) as exc:
             return no_update, f"not a model: {_message(exc)}"
-        lines = [f"{name}: {text}" for name, text in bad.items()]
-        return model.to_dict(), "\n".join(lines)
+        lines = "\n".join(f"{name}: {text}" for name, text in bad.items())
+        spec = model.to_dict()
+        return (no_update if spec == data else spec), lines  # unchanged: no redraw
 
 
-def _incidence(values: list[Any], ids: list[dict[str, str]]) -> float:
-    """The incidence (radians) from the page's controls (degrees); 30 deg while empty."""
-    for i, v in zip(ids, values, strict=True):
-        if i["name"] == THETA_I and v is not None:
-            deg = float(v)
-            if not (math.isfinite(deg) and 0 <= deg < 90):
-                raise ValueError(f"incidence {deg:g} deg: give an angle in [0, 90) degrees")
-            return math.radians(deg)
-    return math.radians(30.0)
+def _incidence(value: Any) -> float:
+    """The incidence (radians) of the page's control (degrees); 30 deg while it is empty."""
+    if value is None:
+        return math.radians(30.0)
+    deg = float(value)
+    if not (math.isfinite(deg) and 0 <= deg < 90):
+        raise ValueError(f"incidence {deg:g} deg: give an angle in [0, 90) degrees")
+    return math.radians(deg)
+
+
+def _warning(fig: Any) -> str:
+    """The albedo figure's warning (an albedo above 1) as one line for the page, or ""."""
+    import re
+
+    from .figures_albedo import WARNING_NAME
+
+    for note in fig.layout.annotations or ():
+        if note.name == WARNING_NAME:
+            return "warning: " + " ".join(re.sub(r"<[^>]+>", " ", str(note.text)).split())
+    return ""
 
 
 def _figure(view: str, session: Session, model: Any, theta_i: float, quantity: str,
@@ -172,24 +184,23 @@ def _view_callbacks(app: dash.Dash, session: Session) -> None:
 
     @app.callback(*outputs,
                   Input("view-tabs", "value"), Input("model-store", "data"),
-                  Input({"role": "input", "name": ALL}, "value"),
+                  Input({"role": "input", "name": THETA_I}, "value"),
                   Input("view-quantity", "value"), Input("view-log", "value"),
-                  Input("view-channel", "value"), Input("view-compare", "value"),
-                  State({"role": "input", "name": ALL}, "id"))
-    def _views(tab: str, data: Any, values: list[Any], quantity: str, log: list[str],
-               channel: Any, mode: str, ids: list[dict[str, str]]) -> list[Any]:
+                  Input("view-channel", "value"), Input("view-compare", "value"))
+    def _views(tab: str, data: Any, incidence: Any, quantity: str, log: list[str],
+               channel: Any, mode: str) -> list[Any]:
         figs: list[Any] = [no_update] * len(views)
         msgs: list[Any] = [no_update] * len(views)
         if tab not in views:
             return figs + msgs
         k = views.index(tab)
         try:
-            theta_i = _incidence(values, ids)
+            theta_i = _incidence(incidence)
             model = _model_of(data)
             with evaluation():
                 figs[k] = _figure(tab, session, model, theta_i, quantity, bool(log), channel,
                                   mode)
-            msgs[k] = ""
+            msgs[k] = _warning(figs[k]) if tab == "albedo" else ""
         except Exception as exc:  # noqa: BLE001 - one line in the tab, and in the terminal
             from ..models.base import NoMuellerMatrix
 

@@ -34,7 +34,7 @@ _MSG = {"color": "#a00", "whiteSpace": "pre-wrap"}
 
 
 def _control(name: str, label: str, value: float | None, lo: float, hi: float,
-             hint: str) -> html.Div:
+             hint: str, marks: dict[float, str] | None = None) -> html.Div:
     """A slider with a typed field (ids ``{"role": "slider"|"input", "name": name}``)."""
     step = (hi - lo) / 200 if hi > lo else 0.01
     slider_value = lo if value is None else min(max(value, lo), hi)
@@ -42,7 +42,8 @@ def _control(name: str, label: str, value: float | None, lo: float, hi: float,
         html.Label(label, title=hint, style={"fontWeight": "bold"}),
         html.Div([
             html.Div(dcc.Slider(id={"role": "slider", "name": name}, min=lo, max=hi, step=step,
-                                value=slider_value, marks=None, updatemode="mouseup",
+                                value=slider_value, marks=marks, updatemode="mouseup",
+                                allow_direct_input=False,  # the typed field is ours
                                 tooltip={"placement": "bottom", "always_visible": False}),
                      style={"flex": "1"}),
             dcc.Input(id={"role": "input", "name": name}, type="number", debounce=True,
@@ -153,6 +154,23 @@ def _tabs(session: Session) -> dcc.Tabs:
     return dcc.Tabs(id="view-tabs", value=first, children=tabs)
 
 
+def _incidences(session: Session) -> tuple[float, dict[float, str] | None]:
+    """The incidence the page starts at (the measured one nearest 30 deg, else 30) and the
+    slider's marks (the measured incidences, when there are at most 24)."""
+    import numpy as np
+
+    meas = session.measurement
+    if meas is None or meas.n_samples == 0:
+        return 30.0, None
+    measured = np.unique(np.round(np.degrees(meas.theta_i), 6))
+    measured = measured[measured < 90]
+    if measured.size == 0:
+        return 30.0, None
+    start = float(measured[np.argmin(np.abs(measured - 30.0))])
+    marks = {float(d): f"{d:g}" for d in measured} if measured.size <= 24 else None
+    return start, marks
+
+
 def layout(session: Session) -> html.Div:
     """The whole page for ``session``; only the message when loading failed."""
     header = html.H2(f"roughbrdf explore - {session.label}", style={"margin": "0.3em 0"})
@@ -160,8 +178,10 @@ def layout(session: Session) -> html.Div:
         return html.Div([header, html.Div(f"error: {session.error}", id="banner",
                                           className="rb-error", style=_MSG)])
     model = session.model
-    incidence = _control(THETA_I, "incidence θi [deg]", 30.0, 0.0, 89.0,
-                         "angle of incidence, degrees from the normal")
+    start, marks = _incidences(session)
+    incidence = _control(THETA_I, "incidence θi [deg]", start, 0.0, 89.0,
+                         "angle of incidence, degrees from the normal"
+                         + (" (marks: the measured ones)" if marks else ""), marks)
     left = html.Div([
         incidence, html.Div(_options(model), id="option-panel"),
         html.Div(parameter_controls(model), id="param-panel"),

@@ -356,3 +356,31 @@ def test_explore_help_loads_no_dash() -> None:
                            "print([m for m in sys.modules if m.startswith(('dash', 'plotly'))"
                            "])"], capture_output=True, text=True, check=False)
     assert proc.stdout.strip() == "[]", proc.stderr
+
+
+def test_a_wildcard_host_takes_ip_literals_and_own_names_only() -> None:
+    """``--host 0.0.0.0``: the Host may be any address of the machine (an IP literal) or its
+    own name, never a foreign name (DNS rebinding); the token is still needed."""
+    server = bind(lambda env, start: (start("200 OK", []), [b"ok"])[1], host="0.0.0.0")
+    server.start_thread()
+    try:
+        token = {TOKEN_HEADER: server.token}
+        assert _request(server.port, "/", host=f"127.0.0.1:{server.port}", headers=token)[0] \
+            == 200
+        assert _request(server.port, "/", host=f"{socket.gethostname()}:{server.port}",
+                        headers=token)[0] == 200
+        assert _request(server.port, "/", host=f"evil.example:{server.port}",
+                        headers=token)[0] == 403
+        assert _request(server.port, "/", host=f"127.0.0.1:{server.port}")[0] == 403
+    finally:
+        server.shutdown()
+
+
+def test_an_explicit_host_says_what_it_exposes() -> None:
+    proc, url = _start("--model", "lambertian", "--host", "0.0.0.0")
+    code, err = _stop(proc)
+    assert url.startswith("http://0.0.0.0:") and code == 130
+    assert "--host 0.0.0.0: listening on every network interface" in err, err
+    proc, url = _start("--model", "lambertian", "--host", "127.0.0.1")
+    code, err = _stop(proc)
+    assert url.startswith("http://127.0.0.1:") and "listening on" not in err and code == 130

@@ -133,7 +133,7 @@ def test_ctrl_c_at_start_is_one_line_exit_130(data, tmp_path):
                      "absolute, robust)"),
     (["--seed", "-1"], "error: --seed must be >= 0 (got -1)"),
     (["--format", "zz"], "error: --format: unknown value 'zz' (choose from astm, alta, merl, "
-                         "csv, zemax)"),
+                         "csv, zemax, lighttools)"),
     (["--relative-to", "zz"], "error: --relative-to: unknown value 'zz' (choose from brdf, "
                               "bridf)"),
     (["--negative", "zz"], "error: --negative zz: must be 'auto', 'keep', 'drop' or 'clip'"),

@@ -41,8 +41,12 @@ def _source(model: str | None, param: list[str] | None, fit_dir: str | None,
         from ..fitting.result import fitted_models
 
         path = Path(fit_dir) / "fit.json" if Path(fit_dir).is_dir() else Path(fit_dir)
+        doc = None
         if path.is_file():
-            doc = json.loads(path.read_text(encoding="utf-8"))
+            try:
+                doc = json.loads(path.read_text(encoding="utf-8"))
+            except (ValueError, RecursionError, OSError):  # fitted_models names the problem
+                doc = None
             if isinstance(doc, dict) and doc.get("per_incidence"):
                 if target != "zemax-abg":
                     raise ValueError(f"{path} is a per-incidence fit (--per-incidence): it "

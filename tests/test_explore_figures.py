@@ -457,3 +457,16 @@ def test_a_real_files_points_are_its_values(shared_data):
     tr, ph = _angles(d)
     np.testing.assert_allclose(d["model"], TR75.brdf(RAD(d["theta_i_deg"]), tr, ph),
                                rtol=1e-12)
+
+
+def test_cuts_log_axis_ignores_a_few_values_near_zero():
+    meas = _measurement(LAMB, channels=("a", "b"))
+    meas.values[2, 0] = 1e-18  # one sample at a file's floor (Mini-Diff has such values)
+    fig = F.plane_cuts(LAMB, meas, n=5)
+    lo, hi = fig.layout.yaxis.range
+    # the 0.5th percentile of the drawn positive values / 3, and the largest x 3 (log10 units)
+    y = np.concatenate([np.asarray(t.y, dtype=float) for t in fig.data if t.yaxis in ("y", "y2")])
+    y = y[y > 0]
+    assert lo == pytest.approx(math.log10(np.percentile(y, 0.5) / 3), rel=1e-12)
+    assert hi == pytest.approx(math.log10(1.1 * 0.5 / math.pi * 3), rel=1e-12)  # data 1.1 rho/pi
+    assert lo > -17  # the 1e-18 sample is below the axis, not stretching it

@@ -164,13 +164,27 @@ def _incidences(cd: ChannelData | None, incidences: Any) -> list[float]:
     return list(np.radians(_MODEL_INCIDENCES_DEG))
 
 
+def _value_range(fig: go.Figure, log: bool) -> list[float] | None:
+    """The value axes' range (both cuts): on a log axis from the 0.5th percentile of the
+    positive values / 3 to the largest x 3 (log10 units, Plotly's), so that a few values near
+    zero (noise, a file's floor) do not stretch it over many decades; None otherwise."""
+    ys = [np.asarray(t.y, dtype=float) for t in fig.data if t.yaxis in ("y", "y2")]
+    v = np.concatenate(ys) if ys else np.array([])
+    v = v[np.isfinite(v) & (v > 0)]
+    if not log or v.size == 0:
+        return None
+    lo = max(float(v.min()), float(np.percentile(v, 0.5))) / 3.0
+    return [math.log10(lo), math.log10(float(v.max()) * 3.0)]
+
+
 def _axes(fig: go.Figure, rows: int, log: bool, ylabel: str) -> None:
+    span = _value_range(fig, log)
     for c in (1, 2):
         fig.update_xaxes(range=[-90, 90], dtick=30, row=rows, col=c,
                          title_text=("signed θr [deg] (− source side φ = 180°)" if c == 1
                                      else "signed θr [deg] (− at φ = −90°)"))
-        fig.update_yaxes(type="log" if log else "linear", row=1, col=c,
-                         title_text=ylabel if c == 1 else None)
+        fig.update_yaxes(type="log" if log else "linear", row=1, col=c, range=span,
+                         exponentformat="power", title_text=ylabel if c == 1 else None)
         if rows == 2:
             fig.update_xaxes(range=[-90, 90], dtick=30, row=1, col=c)
             fig.update_yaxes(row=2, col=c, zeroline=True,

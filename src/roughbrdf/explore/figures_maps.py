@@ -107,11 +107,15 @@ def _scatter(theta_r: np.ndarray, phi: np.ndarray, z: np.ndarray, values: np.nda
              name: str, coloraxis: str, coords: str, unit: str,
              extra: dict[str, np.ndarray]) -> go.Scatter:
     x, y = disk_position(theta_r, phi, coords)
+    sparse = np.size(x) <= 500  # few samples: large outlined markers; many: small plain ones
     cd, meta = custom(("theta_r_deg", "phi_deg", "value", *extra), deg(theta_r), deg(phi),
                       values, *extra.values())
+    # no legend item: the panel's title names it, and Plotly cannot draw a legend symbol for
+    # markers coloured through a colour axis (a console warning per item)
     return go.Scatter(x=x, y=y, mode="markers", name=name, customdata=cd, meta=meta,
-                      marker={"color": z, "coloraxis": coloraxis, "size": 7,
-                              "line": {"width": 0.3, "color": "#444"}},
+                      showlegend=False,
+                      marker={"color": z, "coloraxis": coloraxis, "size": 7 if sparse else 4,
+                              "line": {"width": 0.3 if sparse else 0, "color": "#444"}},
                       hovertemplate=f"{name}<br>{HOVER_ANGLES}<br>%{{customdata[2]:.4g}} "
                                     f"{unit}<extra></extra>")
 

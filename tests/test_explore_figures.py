@@ -470,3 +470,14 @@ def test_cuts_log_axis_ignores_a_few_values_near_zero():
     assert lo == pytest.approx(math.log10(np.percentile(y, 0.5) / 3), rel=1e-12)
     assert hi == pytest.approx(math.log10(1.1 * 0.5 / math.pi * 3), rel=1e-12)  # data 1.1 rho/pi
     assert lo > -17  # the 1e-18 sample is below the axis, not stretching it
+
+
+def test_maps_model_with_a_polarization():
+    fig = F.hemisphere_maps(TR75, theta_i=0.6, resolution=9, polarization="p")
+    v = F.figure_values(fig)["model"]
+    inside = np.isfinite(v["value"])
+    tr, ph = _angles(v)
+    np.testing.assert_allclose(v["value"][inside],
+                               TR75.brdf(0.6, tr[inside], ph[inside], polarization="p"),
+                               rtol=1e-12)
+    assert not np.allclose(v["value"][inside], TR75.brdf(0.6, tr[inside], ph[inside]))

@@ -4,8 +4,7 @@ The lobe is the surface ``r(θr, φ) w_r``: along each reflected direction ``w_r
 sin θr sin φ, cos θr)`` (the library's frame, ``docs/models.md`` §1.1: normal +z, source on −x,
 ``φ = 0`` the forward/specular side) at the distance ``r`` = the BRDF ``f_r`` or ``f_r cos θr``
 (sr⁻¹), or with ``log`` the number of decades above a floor ``10^-decades`` times the largest
-value (Disney's BRDF Explorer draws its "3D plot" the same way). The whole
-``(n_theta × n_phi)`` grid goes through one model evaluation.
+value. The whole ``(n_theta × n_phi)`` grid goes through one model evaluation.
 """
 
 from __future__ import annotations

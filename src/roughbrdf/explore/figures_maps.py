@@ -55,12 +55,13 @@ def _colour(values: np.ndarray, log: bool) -> np.ndarray:
 
 
 def _grid_values(model: Model, theta_i: float, tr: np.ndarray, ph: np.ndarray,
-                 quantity: Quantity, k: float) -> np.ndarray:
+                 quantity: Quantity, k: float, polarization: Any = None) -> np.ndarray:
     inside = np.isfinite(tr)
     out = np.full(tr.shape, np.nan)
     with np.errstate(invalid="ignore", over="ignore"):  # a divergence at the horizon: NaN
         out[inside] = finite_or_nan(model.evaluate(theta_i, tr[inside], ph[inside],
-                                                   quantity=quantity)) / k
+                                                   quantity=quantity,
+                                                   polarization=polarization)) / k
     return out
 
 
@@ -123,7 +124,8 @@ def _scatter(theta_r: np.ndarray, phi: np.ndarray, z: np.ndarray, values: np.nda
 def hemisphere_maps(model: Model | None = None, measurement: Any = None,
                     theta_i: float | None = None, *, channel: int | str | None = None,
                     log: bool = True, quantity: str = "brdf", resolution: int = 101,
-                    coords: str = "cosines", label: str | None = None) -> go.Figure:
+                    coords: str = "cosines", label: str | None = None,
+                    polarization: Any = None) -> go.Figure:
     """Maps of the reflection hemisphere at one incidence: data, model and data/model.
 
     The panels that exist for what is given, left to right: ``"data"`` (the samples at
@@ -149,6 +151,9 @@ def hemisphere_maps(model: Model | None = None, measurement: Any = None,
     log, quantity, resolution, coords, label
         Colour scale, the model's quantity when alone, grid points per side, ``"cosines"``
         or ``"degrees"``, the model's name in the title.
+    polarization : optional
+        The incident polarization of the model map (:meth:`~roughbrdf.models.Model.evaluate`;
+        default unpolarized). The ratio panel always uses each sample's own polarization.
 
     Examples
     --------
@@ -181,7 +186,8 @@ def hemisphere_maps(model: Model | None = None, measurement: Any = None,
         traces.append(("data", _scatter(sub.theta_r, sub.phi, _colour(v, log), v, "data",
                                         "coloraxis", coords, unit, {})))
     if model is not None:
-        grid = _grid_values(model, t, tr, ph, q, cd.k if cd is not None else 1.0)
+        grid = _grid_values(model, t, tr, ph, q, cd.k if cd is not None else 1.0,
+                            polarization)
         traces.append(("model", _heatmap(axis, tr, ph, _colour(grid, log), grid, "model",
                                          "coloraxis", unit)))
     if cd is not None and model is not None and at is not None:

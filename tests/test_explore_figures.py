@@ -481,3 +481,13 @@ def test_maps_model_with_a_polarization():
                                TR75.brdf(0.6, tr[inside], ph[inside], polarization="p"),
                                rtol=1e-12)
     assert not np.allclose(v["value"][inside], TR75.brdf(0.6, tr[inside], ph[inside]))
+
+
+def test_figure_values_decode_typed_arrays_with_either_shape_form():
+    import base64
+
+    a = np.arange(6.0).reshape(2, 3)
+    data = base64.b64encode(a.tobytes()).decode()
+    for shape in ("2, 3", [2, 3]):
+        fig = {"data": [{"name": "t", "z": {"dtype": "f8", "bdata": data, "shape": shape}}]}
+        np.testing.assert_array_equal(F.figure_values(fig)["t"]["z"], a)

@@ -53,9 +53,10 @@ def _array(value: Any) -> np.ndarray | None:
         return None
     if isinstance(value, dict) and "bdata" in value:
         arr = np.frombuffer(base64.b64decode(value["bdata"]), dtype=np.dtype(value["dtype"]))
-        shape = value.get("shape")
-        if shape:
-            arr = arr.reshape([int(s) for s in str(shape).split(",")])
+        shape = value.get("shape")  # "9, 13" from Plotly, a list from some serializers
+        if shape is not None and shape != "":
+            arr = arr.reshape([int(s) for s in str(shape).split(",")] if isinstance(shape, str)
+                              else [int(s) for s in shape])
         return arr.astype(float)
     try:
         return np.asarray(value, dtype=float)

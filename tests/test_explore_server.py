@@ -340,6 +340,11 @@ def test_the_fit_job_reports_and_can_be_cancelled() -> None:
     stopped.cancel()
     stopped.start().join(60)
     assert stopped.state == "cancelled" and stopped.done == 0
+    running = FitJob(rb.model("lambertian"), meas, starts=1).start()
+    running.cancel()  # while the channel is fitted: cancelled at once, its result dropped
+    assert running.state == "cancelled" and running.status().startswith("fit cancelled")
+    running.join(300)
+    assert running.state == "cancelled" and running.models == {} and running.reports == []
 
 
 def test_explore_help_loads_no_dash() -> None:

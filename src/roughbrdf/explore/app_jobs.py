@@ -2,11 +2,12 @@
 
 :class:`FitJob` runs :func:`roughbrdf.fit` in a daemon thread, one channel after the other
 (each channel is one ``rb.fit(..., channel=label)``), so that the page can show the progress
-(channels done) and a cancel takes effect between two channels; the report text of each
-channel is shown when it is done. :func:`export_model` writes the current model with
-:func:`roughbrdf.export.export` into the one folder named at start-up (``--out``) and nowhere
-else: the page gives a file *name*, never a path; nothing is replaced (the project's output
-rules, :mod:`roughbrdf.output`: refused if it exists, written atomically).
+(channels done) and cancel: at once for the page, the channel being fitted finishing in the
+background (a fit cannot be stopped midway from another thread) with its result dropped; the
+report text of each channel is shown when it is done. :func:`export_model` writes the current
+model with :func:`roughbrdf.export.export` into the one folder named at start-up (``--out``)
+and nowhere else: the page gives a file *name*, never a path; nothing is replaced (the
+project's output rules, :mod:`roughbrdf.output`: refused if it exists, written atomically).
 """
 
 from __future__ import annotations
@@ -85,8 +86,12 @@ class FitJob:
         return self
 
     def cancel(self) -> None:
-        """Stop after the channel being fitted."""
+        """Cancel now: the job is ``"cancelled"`` at once and nothing more is recorded; a
+        channel being fitted finishes in the background (a fit cannot be stopped midway) and
+        its result is dropped."""
         self._cancel.set()
+        if self.state == "running":
+            self.state = "cancelled"
 
     def join(self, timeout: float | None = None) -> None:
         self._thread.join(timeout)
@@ -103,18 +108,20 @@ class FitJob:
         try:
             for label in self.channels:
                 if self._cancel.is_set():
-                    self.state = "cancelled"
                     return
                 with evaluation(fit=True):
                     res = rb.fit(self.model, self.measurement, channel=label, progress=False,
                                  **self.options)
+                if self._cancel.is_set():  # cancelled while this channel was fitted: dropped
+                    return
                 self.models[label] = res.channels[0].model
                 self.reports.append(res.report())
                 self.done += 1
             self.state = "finished"
         except Exception as exc:  # noqa: BLE001 - shown on the page as one line
-            self.error = error_message(exc)
-            self.state = "failed"
+            if not self._cancel.is_set():
+                self.error = error_message(exc)
+                self.state = "failed"
 
     def status(self) -> str:
         """One line for the page."""
@@ -122,7 +129,10 @@ class FitJob:
             return f"fitting: {self.done} of {self.total} channels done"
         if self.state == "failed":
             return f"fit failed: {self.error}"
-        return f"fit {self.state}: {self.done} of {self.total} channels"
+        if self.state == "cancelled":
+            return (f"fit cancelled after {self.done} of {self.total} channels (a channel "
+                    "being fitted finishes in the background; its result is dropped)")
+        return f"fit finished: {self.done} of {self.total} channels"
 
 
 def export_model(model: Model, out: Path | None, name: str, to: str) -> str:

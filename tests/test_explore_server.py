@@ -206,6 +206,13 @@ def test_a_port_out_of_range_is_a_usage_error(capsys: pytest.CaptureFixture[str]
     assert code == 2 and "--port" in capsys.readouterr().err
 
 
+def test_nothing_to_explore_is_a_usage_error(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["explore", "--no-browser"]) == 2
+    assert "nothing to explore" in capsys.readouterr().err
+    assert main(["explore", "-p", "rho=0.2", str(ZEMAX), "--no-browser"]) == 2
+    assert "give --model" in capsys.readouterr().err
+
+
 def test_a_host_that_is_not_here_is_a_usage_error(capsys: pytest.CaptureFixture[str]) -> None:
     code = main(["explore", "--model", "lambertian", "--host", "192.0.2.1", "--no-browser"])
     err = capsys.readouterr().err

@@ -27,6 +27,8 @@ def run_explore(file: str | None, fit_dir: str | None, model: str | None,
                 param: list[str] | None, *, port: int | None, host: str | None,
                 out: str | None, browser: bool) -> None:
     """The work of ``roughbrdf explore``: load, bind, print the address, serve until Ctrl-C."""
+    if file is None and fit_dir is None and model is None:
+        raise ValueError("nothing to explore: give a measurement FILE, --fit DIR or --model SPEC")
     if param and model is None:
         raise ValueError("-p/--param sets the parameters of --model SPEC; give --model")
     try:

@@ -237,7 +237,7 @@ def _action_callbacks(app: dash.Dash, session: Session) -> None:
             session.fit_models.update(job.models)
         progress = f"{job.done / job.total if job.total else 1.0:.3f}"
         return (not running, job.status(), running, not running, progress,
-                job.report if job.reports or not running else no_update)
+                job.report if job.reports else no_update)
 
     @app.callback(Output("export-msg", "children"), Input("export-go", "n_clicks"),
                   State("export-to", "value"), State("export-name", "value"),

@@ -310,14 +310,24 @@ def test_a_fit_loads_fits_from_here_and_exports(browser: Any, serve: Callable[..
     assert _severe(browser) == []
 
 
-def test_a_bad_file_is_one_message_on_the_page(browser: Any, serve: Callable[..., Any],
-                                               tmp_path: Path) -> None:
-    bad = tmp_path / "broken.astm"
-    bad.write_text("not an ASTM file\n")
-    _open(browser, serve(str(bad)))
+@pytest.mark.parametrize("case", ["bad file", "fit input gone"])
+def test_a_bad_input_is_one_message_on_the_page(browser: Any, serve: Callable[..., Any],
+                                                tmp_path: Path, case: str) -> None:
+    if case == "bad file":
+        culprit = tmp_path / "broken.astm"
+        culprit.write_text("not an ASTM file\n")
+        server = serve(str(culprit))
+    else:
+        culprit = tmp_path / "ano.bsdf"
+        shutil.copy(ZEMAX, culprit)
+        rb.fit(rb.model("lambertian"), rb.read(culprit), starts=1, progress=False).save(
+            tmp_path / "fit", plots=False)
+        culprit.unlink()
+        server = serve(fit_dir=str(tmp_path / "fit"))
+    _open(browser, server)
     messages = browser.execute_script("return Array.from(document.querySelectorAll("
                                       "'.rb-error')).map(e => e.textContent)")
-    assert len(messages) == 1 and "broken.astm" in messages[0]
+    assert len(messages) == 1 and culprit.name in messages[0]
     body = browser.execute_script("return document.body.innerText")
     assert "Traceback" not in body and body.count("error:") == 1
     assert _severe(browser) == []

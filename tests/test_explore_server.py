@@ -262,21 +262,29 @@ def test_ctrl_c_stops_the_server_with_130() -> None:
         socket.create_connection(("127.0.0.1", port), timeout=5).close()
 
 
-def test_a_bad_file_is_one_message_in_the_terminal_and_the_page(tmp_path: Path) -> None:
-    bad = tmp_path / "broken.astm"
-    bad.write_text("this is not an ASTM file\n1 2 3\n")
-    proc, url = _start(str(bad))
+@pytest.mark.parametrize("case", ["bad file", "fit input gone"])
+def test_a_bad_input_is_one_message_in_the_terminal_and_the_page(tmp_path: Path,
+                                                                 case: str) -> None:
+    if case == "bad file":
+        culprit = tmp_path / "broken.astm"
+        culprit.write_text("this is not an ASTM file\n1 2 3\n")
+        args = [str(culprit)]
+    else:
+        folder, culprit = _fit_folder(tmp_path)
+        culprit.unlink()
+        args = ["--fit", str(folder)]
+    proc, url = _start(*args)
     port, token = int(url.split(":")[2].split("/")[0]), url.split("token=")[1]
     status, _, layout = _request(port, "/_dash-layout", headers={TOKEN_HEADER: token})
     code, err = _stop(proc)
     assert status == 200
     errors = [line for line in err.splitlines() if line.startswith("error:")]
-    assert len(errors) == 1 and "broken.astm" in errors[0], err
+    assert len(errors) == 1 and str(culprit.name) in errors[0], err
     assert "Traceback" not in err and code == 130
     text = json.dumps(json.loads(layout))
-    assert text.count("error: ") == 1 and "broken.astm" in text
-    assert errors[0].removeprefix("error: ") in json.loads(layout)["props"]["children"][1][
-        "props"]["children"]
+    assert text.count("error: ") == 1 and culprit.name in text
+    banner = json.loads(layout)["props"]["children"][1]["props"]
+    assert banner["id"] == "banner" and banner["children"] == errors[0]
 
 
 def _fit_folder(tmp_path: Path) -> tuple[Path, Path]:

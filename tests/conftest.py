@@ -36,3 +36,18 @@ def paints(shared_data: Path) -> dict[str, rb.Measurement]:
     """``{name: Measurement}`` of the :data:`MINIDIFF_PAINTS`, read once per test module (a
     module's tests may keep what they read); skips without ../shared/data."""
     return {name: rb.read(shared_data / "minidiff" / f"{name}.astm") for name in MINIDIFF_PAINTS}
+
+
+@pytest.fixture(autouse=True)
+def _sigint_handler_kept():
+    """Every test leaves the SIGINT handler as it found it; one that does not fails, and the
+    handler is put back so that the tests after it (Ctrl-C handling, tests/test_output.py,
+    tests/test_cli_interrupts.py) are not failed by it (a leak once seen in CI under load)."""
+    import signal
+
+    before = signal.getsignal(signal.SIGINT)
+    yield
+    after = signal.getsignal(signal.SIGINT)
+    if after is not before:
+        signal.signal(signal.SIGINT, before)
+        pytest.fail(f"the test left the SIGINT handler changed ({after!r}; was {before!r})")

@@ -1,5 +1,5 @@
 """``roughbrdf explore [FILE] [--fit DIR] [--model SPEC -p NAME=VALUE ...] [--port N]
-[--host H] [--out DIR] [--no-browser]``: the web explorer (``docs/explore.md``).
+[--host H] [--out DIR] [--format F] [--no-browser]``: the web explorer (``docs/explore.md``).
 
 Starts a local web application (Dash; ``pip install roughbrdf[explore]``) showing a
 measurement, a model and a fit, prints its address with the run's token and opens a browser
@@ -19,13 +19,12 @@ import typer
 from .common import handled, parse_params
 
 #: the library's argument names -> this verb's options
-OPTIONS = {"format": "--format", "quantity": "--quantity", "out": "--out", "host": "--host",
-           "port": "--port"}
+OPTIONS = {"format": "--format", "out": "--out", "host": "--host", "port": "--port"}
 
 
 def run_explore(file: str | None, fit_dir: str | None, model: str | None,
                 param: list[str] | None, *, port: int | None, host: str | None,
-                out: str | None, browser: bool) -> None:
+                out: str | None, browser: bool, format: str | None = None) -> None:
     """The work of ``roughbrdf explore``: load, bind, print the address, serve until Ctrl-C."""
     if file is None and fit_dir is None and model is None:
         raise ValueError("nothing to explore: give a measurement FILE, --fit DIR or --model SPEC")
@@ -45,7 +44,7 @@ def run_explore(file: str | None, fit_dir: str | None, model: str | None,
     if out is not None:
         ensure_folder(out)
     session = load_session(file, fit_dir=fit_dir, model=model, params=parse_params(param),
-                           out=out)
+                           out=out, format=format)
     if session.error:
         typer.echo(f"error: {session.error}", err=True)
     server = bind(build_app(session).server, host=host, port=0 if port is None else port)
@@ -86,6 +85,9 @@ def register(app: typer.Typer) -> None:
         out: str = typer.Option(None, "--out", "-o", metavar="DIR",
                                 help="the one folder exports are written into (default: "
                                      "export off)"),
+        format: str = typer.Option(None, "--format",
+                                   help="the FILE's format, overriding the one chosen from "
+                                        "its extension (astm, alta, merl, csv, zemax, ...)"),
         browser: bool = typer.Option(True, "--browser/--no-browser",
                                      help="open the address in a browser when one is "
                                           "available"),
@@ -93,4 +95,4 @@ def register(app: typer.Typer) -> None:
         """Explore a measurement, a model and a fit in the browser (local web app)."""
         with handled(OPTIONS):
             run_explore(file, fit_dir, model, param, port=port, host=host, out=out,
-                        browser=browser)
+                        browser=browser, format=format)

@@ -85,7 +85,7 @@ def _fit_inputs(fit_dir: str) -> tuple[dict[str, Model], Measurement, str]:
 
 def load_session(file: str | None = None, *, fit_dir: str | None = None,
                  model: str | None = None, params: dict[str, Any] | None = None,
-                 out: str | None = None) -> Session:
+                 out: str | None = None, format: str | None = None) -> Session:
     """Load the inputs of a run; an error becomes :attr:`Session.error` (one line, the
     command line's wording: :func:`roughbrdf.cli.common.error_message`).
 
@@ -110,11 +110,11 @@ def load_session(file: str | None = None, *, fit_dir: str | None = None,
             session.fit_models, session.measurement, session.fit_report = _fit_inputs(fit_dir)
             session.model = next(iter(session.fit_models.values()))
         if file is not None:
-            session.measurement = rb.read(file)
+            session.measurement = rb.read(file, format=format)
         if model is not None:
             session.model = cli_model(model, params)
     except Exception as exc:  # noqa: BLE001 - every failure is the page's one message
-        session.error = error_message(exc, {"format": "--format", "quantity": "--quantity"})
+        session.error = error_message(exc, {"format": "--format"})
     return session
 
 

@@ -63,8 +63,8 @@ class _OfflineDash(dash.Dash):
 def build_app(session: Session) -> dash.Dash:
     """The Dash application for ``session`` (serve its ``.server``, a Flask WSGI app)."""
     app = _OfflineDash("roughbrdf.explore", serve_locally=True, title="roughbrdf explore",
-                    update_title=None,  # type: ignore[arg-type]
-                        suppress_callback_exceptions=True, compress=False)
+                       update_title=None,  # type: ignore[arg-type]  # None: no "Updating..."
+                       suppress_callback_exceptions=True, compress=False)
     app.layout = layout(session)
     if not session.error:
         _controls_callbacks(app, session)
@@ -128,7 +128,8 @@ def _controls_callbacks(app: dash.Dash, session: Session) -> None:
             model, bad = model_from_controls(base, typed, chosen)
         except (ValueError, TypeError) as exc:
             return no_update, f"not a model: {_message(exc)}"
-        lines = "\n".join(f"{name}: {text}" for name, text in bad.items())
+        lines = "\n".join(text if repr(name) in text else f"{name}: {text}"
+                          for name, text in bad.items())
         spec = model.to_dict()
         return (no_update if spec == data else spec), lines  # unchanged: no redraw
 

@@ -156,13 +156,18 @@ def _warning(fig: Any) -> str:
     return ""
 
 
+#: the 3-D lobe's grid (theta_r x phi): issue 22's benchmark size (benchmarks/bench_explore.py)
+LOBE_GRID = (64, 256)
+
+
 def _figure(view: str, session: Session, model: Any, theta_i: float, quantity: str,
             log: bool, channel: Any, mode: str) -> Any:
     from . import figures
 
     meas = session.measurement
     if view == "lobe":
-        return figures.lobe_3d(model, theta_i, quantity=quantity, log=log)
+        return figures.lobe_3d(model, theta_i, quantity=quantity, log=log,
+                               resolution=LOBE_GRID[0], n_phi=LOBE_GRID[1])
     if view == "cuts":
         return figures.plane_cuts(model, meas, channel=channel, log=True)
     if view == "maps":
@@ -175,7 +180,7 @@ def _figure(view: str, session: Session, model: Any, theta_i: float, quantity: s
     other = session.fit_models.get(str(channel)) if session.fit_models else None
     other = other if other is not None else session.model
     return figures.compare_lobes(model, other if other is not None else model, theta_i,
-                                 mode=mode)
+                                 mode=mode, quantity=quantity, log=log)
 
 
 def _view_callbacks(app: dash.Dash, session: Session) -> None:

@@ -152,7 +152,9 @@ def _scene(log: bool, floor: float, quantity: Quantity, reach: float | None = No
         "xaxis": {"title": {"text": f"x = {q} sin θr cos φ [{unit}] (φ = 0°: specular →)"}},
         "yaxis": {"title": {"text": f"y = {q} sin θr sin φ [{unit}]"}},
         "zaxis": {"title": {"text": f"z = {q} cos θr [{unit}] (normal)"}},
-        "aspectmode": "data", "camera": {"eye": {"x": 0.2, "y": -1.8, "z": 0.9}}}
+        # outside the box whatever the lobe's shape (an "data" aspect box of a narrow spike put
+        # this eye inside it: only crossing lines were drawn)
+        "aspectmode": "data", "camera": {"eye": {"x": 0.4, "y": -2.2, "z": 1.3}}}
     if reach is not None:
         for k, lo in (("xaxis", -reach), ("yaxis", -reach), ("zaxis", 0.0)):
             axes[k]["range"] = [lo, reach]
@@ -233,7 +235,8 @@ def lobe_3d(model: Model, theta_i: float, *, quantity: str = "brdf", log: bool =
                                                 + (" (log radius)" if log else "") + pol,
                                                 model, label=label, theta_i=t,
                                                 channel=channel)},
-                      scene=_scene(log, floor, q), margin={"l": 0, "r": 0, "t": 50, "b": 0},
+                      scene=_scene(log, floor, q, _reach([grid], log, floor)),
+                      margin={"l": 0, "r": 0, "t": 50, "b": 0},
                       legend={"x": 0.01, "y": 0.99})
     return fig
 
@@ -293,7 +296,7 @@ def compare_lobes(model_a: Model, model_b: Model, theta_i: float, *, mode: str =
     fig.update_layout(title={"text": title_text(what, label=f"{names[0]} vs {names[1]}",
                                                 theta_i=t)},
                       margin={"l": 0, "r": 0, "t": 60, "b": 0}, legend={"x": 0.01, "y": 0.99})
-    fig.update_layout(scene=_scene(log, floor, q, reach if side else None))
+    fig.update_layout(scene=_scene(log, floor, q, reach))  # one fixed box: any lobe shape
     if side:
         fig.update_layout(scene2=_scene(log, floor, q, reach))
     return fig

@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
-import tempfile
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -19,12 +17,10 @@ from typing import Any
 
 import numpy as np
 import pytest
+from chromium import chromium
 
 from roughbrdf.catalogue.summary import write_summary
 from roughbrdf.output import OverwriteRefused
-
-CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
-CHROMEDRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
 
 
 def make_rows(n: int, folder: Path | None = None, n_figures: int = 0) -> list[dict[str, Any]]:
@@ -161,27 +157,9 @@ def test_hundred_thousand_rows_stay_small(tmp_path: Path) -> None:
 
 @pytest.fixture(scope="module")
 def browser() -> Iterator[Any]:
-    """Headless Debian Chromium through the system chromedriver (nothing downloaded)."""
-    if not (Path(CHROMIUM).exists() and Path(CHROMEDRIVER).exists()):
-        pytest.skip(f"Chromium and chromedriver not installed ({CHROMIUM}, {CHROMEDRIVER}); "
-                    "`make test` as root installs Debian's chromium and chromium-driver")
-    webdriver = pytest.importorskip("selenium.webdriver")
-    from selenium.webdriver.chrome.service import Service
-    profile = tempfile.mkdtemp(prefix="rb-chromium-")
-    opts = webdriver.ChromeOptions()
-    opts.binary_location = CHROMIUM
-    for flag in ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
-                 "--no-first-run", "--disable-background-networking",
-                 "--disable-component-update", "--disable-sync", "--window-size=1400,1000",
-                 f"--user-data-dir={profile}"):
-        opts.add_argument(flag)
-    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    driver = webdriver.Chrome(options=opts, service=Service(executable_path=CHROMEDRIVER))
-    try:
+    """Headless Debian Chromium (tests/chromium.py)."""
+    with chromium() as driver:
         yield driver
-    finally:
-        driver.quit()
-        shutil.rmtree(profile, ignore_errors=True)
 
 
 #: seconds the page's script may take before the test counts it as hung (not a speed figure:

@@ -19,7 +19,6 @@ import io
 import json
 import math
 import shutil
-import tempfile
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -30,49 +29,24 @@ import pytest
 
 pytest.importorskip("dash", reason="the explore extra (pip install roughbrdf[explore])")
 
+from chromium import WEBGL, chromium  # noqa: E402
+
 import roughbrdf as rb  # noqa: E402
 from roughbrdf.explore.app import build_app  # noqa: E402
 from roughbrdf.explore.app_state import load_session  # noqa: E402
 from roughbrdf.explore.figures import figure_values  # noqa: E402
 from roughbrdf.explore.server import bind  # noqa: E402
 
-CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
-CHROMEDRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
 DATA = Path(__file__).parent / "data"
 ZEMAX = DATA / "zemax" / "AnoBlackNiTEonINVAR.bsdf"
 #: seconds the page may take to reach a state before the test counts it as hung (a first
 #: evaluation may compile kernels; not a speed figure)
 HANG = 240
-FLAGS = ("--headless", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-         "--disable-quic", "--no-first-run", "--disable-background-networking",
-         "--disable-component-update", "--disable-sync", "--window-size=1400,1000")
-
-
 @pytest.fixture(scope="module")
 def browser() -> Iterator[Any]:
-    """Headless Debian Chromium through the system chromedriver (nothing downloaded)."""
-    if not (Path(CHROMIUM).exists() and Path(CHROMEDRIVER).exists()):
-        pytest.skip(f"Chromium and chromedriver not installed ({CHROMIUM}, {CHROMEDRIVER}); "
-                    "`make test` as root installs Debian's chromium and chromium-driver")
-    webdriver = pytest.importorskip("selenium.webdriver")
-    from selenium.common.exceptions import WebDriverException
-    from selenium.webdriver.chrome.service import Service
-    profile = tempfile.mkdtemp(prefix="rb-chromium-")
-    opts = webdriver.ChromeOptions()
-    opts.binary_location = CHROMIUM
-    for flag in (*FLAGS, f"--user-data-dir={profile}"):
-        opts.add_argument(flag)
-    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    try:
-        driver = webdriver.Chrome(options=opts, service=Service(executable_path=CHROMEDRIVER))
-    except WebDriverException as exc:
-        shutil.rmtree(profile, ignore_errors=True)
-        pytest.skip(f"Chromium cannot start here: {' '.join(str(exc).split())[:300]}")
-    try:
+    """Headless Debian Chromium with software WebGL (tests/chromium.py)."""
+    with chromium(WEBGL) as driver:
         yield driver
-    finally:
-        driver.quit()
-        shutil.rmtree(profile, ignore_errors=True)
 
 
 @pytest.fixture

@@ -38,6 +38,28 @@ def paints(shared_data: Path) -> dict[str, rb.Measurement]:
     return {name: rb.read(shared_data / "minidiff" / f"{name}.astm") for name in MINIDIFF_PAINTS}
 
 
+_LAST_TEST: list[str] = ["(none: collection)"]
+
+
+def pytest_runtest_setup(item: pytest.Item) -> None:
+    """Every test starts with Python's own SIGINT handler. One left changed between tests
+    (by a module-scoped fixture's teardown, which no test owns: seen in CI in fresh clones
+    under load, SIG_IGN, which failed five later tests of Ctrl-C handling) is put back, with a
+    warning naming the test after which it was found."""
+    import signal
+    import warnings
+
+    handler = signal.getsignal(signal.SIGINT)
+    if handler is not signal.default_int_handler:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        warnings.warn(f"the SIGINT handler was {handler!r} before {item.nodeid} (after "
+                      f"{_LAST_TEST[0]}): put back", stacklevel=1)
+
+
+def pytest_runtest_teardown(item: pytest.Item) -> None:
+    _LAST_TEST[0] = item.nodeid
+
+
 @pytest.fixture(autouse=True)
 def _sigint_handler_kept():
     """Every test leaves the SIGINT handler as it found it; one that does not fails, and the

@@ -16,6 +16,7 @@ loaded 2-core machine can double every figure. Needs ``../shared/data`` (or
 from __future__ import annotations
 
 import os
+import sys
 import time
 import warnings
 from collections.abc import Callable
@@ -24,28 +25,17 @@ from pathlib import Path
 import roughbrdf as rb
 from roughbrdf.fitting.compare import fit_auto
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # run.py loads by path
+from machine import load, vector_width  # noqa: E402
+
 HERE = Path(__file__).resolve().parent
 DATA = Path(os.environ.get("ROUGHBRDF_SHARED_DATA", HERE.parent.parent / "shared" / "data"))
 FILE = "C2_Black"
 REPEAT = 2
 
 
-def vector_width() -> str:
-    """The widest SIMD unit the CPU reports (``/proc/cpuinfo`` flags)."""
-    try:
-        flags = next(ln for ln in Path("/proc/cpuinfo").read_text().splitlines()
-                     if ln.startswith("flags")).split()
-    except (OSError, StopIteration):  # not Linux: unknown
-        return "unknown"
-    return next((f for f in ("avx512f", "avx2", "avx", "sse4_2") if f in flags), "none")
 
 
-def load() -> str:
-    """The 1-minute load average (``os.getloadavg``), or "n/a"."""
-    try:
-        return f"{os.getloadavg()[0]:.2f}"
-    except OSError:
-        return "n/a"
 
 
 def best(call: Callable[[], object]) -> float:

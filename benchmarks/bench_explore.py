@@ -53,6 +53,9 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # run.py loads by path
+from machine import cpu_name, load, vector_width  # noqa: E402
+
 HERE = Path(__file__).resolve().parent
 DATA = Path(os.environ.get("ROUGHBRDF_SHARED_DATA", HERE.parent.parent / "shared" / "data"))
 FILE = "C2_Black"
@@ -72,31 +75,10 @@ HANG = 240.0
 TABS = {"lobe": "3-D lobe", "cuts": "In/cross-plane cuts", "maps": "Hemisphere maps"}
 
 
-def cpu_name() -> str:
-    """The CPU's ``model name`` in ``/proc/cpuinfo``."""
-    try:
-        return next(ln.split(":", 1)[1].strip() for ln in
-                    Path("/proc/cpuinfo").read_text().splitlines() if ln.startswith("model name"))
-    except (OSError, StopIteration):  # not Linux: unknown
-        return "unknown"
 
 
-def vector_width() -> str:
-    """The widest SIMD unit the CPU reports (``/proc/cpuinfo`` flags)."""
-    try:
-        flags = next(ln for ln in Path("/proc/cpuinfo").read_text().splitlines()
-                     if ln.startswith("flags")).split()
-    except (OSError, StopIteration):  # not Linux: unknown
-        return "unknown"
-    return next((f for f in ("avx512f", "avx2", "avx", "sse4_2") if f in flags), "none")
 
 
-def load() -> str:
-    """The 1-minute load average (``os.getloadavg``), or "n/a"."""
-    try:
-        return f"{os.getloadavg()[0]:.2f}"
-    except OSError:
-        return "n/a"
 
 
 # -- the explorer in a subprocess --------------------------------------------------------------

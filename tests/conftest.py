@@ -38,13 +38,15 @@ def paints(shared_data: Path) -> dict[str, rb.Measurement]:
     return {name: rb.read(shared_data / "minidiff" / f"{name}.astm") for name in MINIDIFF_PAINTS}
 
 
-_LAST_TEST: list[str] = ["(none: collection)"]
+_LAST_TEST: list[str] = ["(none: inherited from the process that started pytest)"]
 
 
 def pytest_runtest_setup(item: pytest.Item) -> None:
-    """Every test starts with Python's own SIGINT handler. One left changed between tests
-    (by a module-scoped fixture's teardown, which no test owns: seen in CI in fresh clones
-    under load, SIG_IGN, which failed five later tests of Ctrl-C handling) is put back, with a
+    """Every test starts with Python's own SIGINT handler, which the tests of Ctrl-C handling
+    assume. A pytest started as a background job of a non-interactive shell (``cmd &`` in a
+    script: POSIX shells start those with SIGINT ignored) inherits SIG_IGN, and five tests of
+    Ctrl-C handling failed for it; a handler left changed between tests (a module-scoped
+    fixture's teardown, which no test owns) would do the same. Either is put back, with a
     warning naming the test after which it was found."""
     import signal
     import warnings
@@ -64,7 +66,7 @@ def pytest_runtest_teardown(item: pytest.Item) -> None:
 def _sigint_handler_kept():
     """Every test leaves the SIGINT handler as it found it; one that does not fails, and the
     handler is put back so that the tests after it (Ctrl-C handling, tests/test_output.py,
-    tests/test_cli_interrupts.py) are not failed by it (a leak once seen in CI under load)."""
+    tests/test_cli_interrupts.py) are not failed by it."""
     import signal
 
     before = signal.getsignal(signal.SIGINT)

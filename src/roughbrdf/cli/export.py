@@ -10,7 +10,9 @@ JSON, or a Mitsuba 3 XML ``<bsdf>``. What does not map onto Mitsuba is refused w
 or with ``--fit-closest`` exported as the closest Mitsuba model fitted to it, with the deviation
 printed. A model that reflects more than it receives (albedo above 1 + 1e-3 at an incidence of
 0, 5, ... 85, 89 deg) is refused unless ``--allow-energy-gain``, which the file records.
-Nothing is replaced without ``--force``; every file is written atomically.
+Nothing is replaced without ``--force``; every file is written atomically. The folder of
+``--fit`` is checked first (:func:`roughbrdf.result_check.check_result_folder`): a write cut
+off by a kill is completed or undone, a folder being written or changed since is refused.
 """
 
 from __future__ import annotations
@@ -39,8 +41,11 @@ def _source(model: str | None, param: list[str] | None, fit_dir: str | None,
         import json
 
         from ..fitting.result import fitted_models
+        from ..result_check import check_result_folder
 
         path = Path(fit_dir) / "fit.json" if Path(fit_dir).is_dir() else Path(fit_dir)
+        # one whole set (a cut-off write recovered) or refused, before fit.json is read
+        check_result_folder(path.parent, options=OPTIONS)
         doc = None
         if path.is_file():
             try:

@@ -6,7 +6,9 @@
 with ``extend=True``: a later ``roughbrdf fit --force`` into DIR replaces them with the rest).
 The measurement of the fit is found from any folder (``fit.json``'s ``file``, else
 ``file_abspath``, else ``file`` beside ``fit.json``); a warning says when it has changed since
-the fit (``file_sha256``).
+the fit (``file_sha256``). The fit's folder is checked first, as every reader of a results
+folder checks it (:func:`roughbrdf.result_check.check_result_folder`): a write cut off by a kill
+is completed or undone, a folder being written or changed since roughbrdf wrote it is refused.
 """
 
 from __future__ import annotations
@@ -234,7 +236,10 @@ def _fit_figures(fit_dir: Path, out: Path | None, channel: str | None, force: bo
     the fit's results in its folder; everything is checked before the drawing."""
     from ..fitting.result import check_fit_channels, read_fit_json
     from ..output import ResultFolder
+    from ..result_check import check_result_folder
 
+    # one whole set (a cut-off write recovered) or refused, before fit.json is trusted
+    check_result_folder(fit_dir if fit_dir.is_dir() else fit_dir.parent, options=OPTIONS)
     fit, base = read_fit_json(fit_dir, channels=False)
     _input_file(fit, base)  # the measurement named first: without it nothing can be drawn
     check_fit_channels(fit, fit_dir / "fit.json" if fit_dir.is_dir() else fit_dir)

@@ -24,6 +24,8 @@ __all__ = ["Session", "load_session", "option_choices", "shown_value", "shown_un
 
 #: the unit of parameters shown in degrees on the page
 ANGLE_UNIT = "rad"
+#: the command line options that loading errors name (:func:`load_session`)
+CLI_OPTIONS = {"format": "--format"}
 
 
 @dataclass
@@ -58,8 +60,16 @@ class Session:
 
 def _fit_inputs(fit_dir: str) -> tuple[dict[str, Model], Measurement, str]:
     """The fitted models, the measurement and the report of a fit folder: ``rb.load_fit`` when
-    the library has it, else ``fit.json`` and the measurement at its recorded path."""
+    the library has it, else ``fit.json`` and the measurement at its recorded path; the
+    folder checked first (:func:`roughbrdf.result_check.check_result_folder`)."""
     import roughbrdf as rb
+
+    from ..result_check import check_result_folder
+
+    where = Path(fit_dir)
+    # one whole set (a cut-off write recovered) or refused, worded for the command line (the
+    # options load_session words its errors with)
+    check_result_folder(where if where.is_dir() else where.parent, options=CLI_OPTIONS)
 
     loader = getattr(rb, "load_fit", None)
     if loader is not None:
@@ -114,7 +124,7 @@ def load_session(file: str | None = None, *, fit_dir: str | None = None,
         if model is not None:
             session.model = cli_model(model, params)
     except Exception as exc:  # noqa: BLE001 - every failure is the page's one message
-        session.error = error_message(exc, {"format": "--format"})
+        session.error = error_message(exc, CLI_OPTIONS)
     return session
 
 

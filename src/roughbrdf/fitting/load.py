@@ -23,6 +23,13 @@ What ``fit.json`` does not hold is rebuilt or left empty, and said so:
 
 A per-incidence fit (``fit.json`` with ``"per_incidence": true``) and a Mueller-matrix fit are
 refused with a message saying what to do instead.
+
+Before anything is read, the folder is checked as every reader of a results folder checks it
+(:func:`roughbrdf.result_check.check_result_folder`): a write into it that a kill cut off (its
+commit journal) is completed or undone, so that ``fit.json`` is of the same set as the rest; a
+folder another live run is writing into, one with a journal that cannot be written, or one
+where a file no longer has the SHA-256 its manifest records is refused
+(:class:`~roughbrdf.result_check.ResultFolderRefused`).
 """
 
 from __future__ import annotations
@@ -86,6 +93,10 @@ def load_fit(fit: str | os.PathLike, *, measurement: Measurement | str | os.Path
     ValueError
         A file that is not a fit's JSON; a per-incidence or Mueller-matrix fit (the message
         says what to use); a recorded value roughbrdf cannot rebuild.
+    roughbrdf.result_check.ResultFolderRefused
+        (a ``ValueError``) The folder is not one whole set roughbrdf wrote and cannot be made
+        one: another run is writing into it, a cut-off write cannot be recovered (the folder
+        is read-only), or a file was changed after roughbrdf wrote it (module notes).
 
     Warns
     -----
@@ -105,8 +116,11 @@ def load_fit(fit: str | os.PathLike, *, measurement: Measurement | str | os.Path
     >>> back.params == res.params, back.report() == res.report()
     (True, True)
     """
+    from ..result_check import check_result_folder
+
     path = Path(fit)
     path = path / "fit.json" if path.is_dir() else path
+    check_result_folder(path.parent)  # one whole set (a cut-off write recovered) or refused
     try:
         content, folder = read_fit_json(path)
     except ValueError:

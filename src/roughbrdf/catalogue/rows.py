@@ -1,4 +1,4 @@
-"""The rows of a catalogue and the files ``catalogue.csv`` / ``catalogue.json``.
+r"""The rows of a catalogue and the files ``catalogue.csv`` / ``catalogue.json``.
 
 Row schema (one ``dict`` per input file x channel; :func:`roughbrdf.catalogue.summary` and
 other tools rely on these keys):
@@ -33,9 +33,12 @@ other tools rely on these keys):
                   or None)
 ``albedo``        ``{theta_i_deg: albedo}`` (``catalogue.csv``: ``albedo_<deg>`` columns)
 ``peak_ratios``   ``{theta_i_deg: ratio}`` per measured incidence (``peak_ratio_<deg>``)
+``earlier_status`` for a ``"skipped (resume)"`` row: the status it had when it was fitted
+                  (:func:`outcome`), else None
 ================  ============================================================================
 
-A ``"skipped (resume)"`` row carries the values of the earlier run it kept.
+A ``"skipped (resume)"`` row carries the values of the earlier run it kept, and its ``file``
+names the input where it is now (the same bytes may have moved since).
 ``catalogue.csv`` flattens ``params`` and ``stderr`` into ``param_<name>`` and
 ``stderr_<name>`` columns (the union over all rows, in order of appearance); ``catalogue.json``
 is ``{"rows": [...]}`` with the rows as they are (NaN written as null).
@@ -47,6 +50,8 @@ Examples
 ('failed', None, {})
 >>> csv_text([row]).splitlines()[0].split(",")[:4]
 ['file', 'channel', 'model', 'status']
+>>> shown_name("plain name.astm"), shown_name("two\nlines.astm")
+('plain name.astm', "'two\\nlines.astm'")
 """
 
 from __future__ import annotations
@@ -61,18 +66,20 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from ..fitting.result import FitResult
 
-__all__ = ["BY_INCIDENCE", "COLUMNS", "STATUSES", "failed_row", "fit_rows", "csv_text",
-           "json_text", "status_of"]
+__all__ = ["BY_INCIDENCE", "COLUMNS", "STATUSES", "SKIPPED", "failed_row", "fit_rows",
+           "csv_text", "json_text", "status_of", "outcome", "shown_name", "one_line"]
 
 #: the statuses a row can have
 STATUSES = ("ok", "not converged", "at-search-limit", "gains-energy", "failed",
             "skipped (resume)")
+#: the status of a row kept from an earlier run by ``--resume``
+SKIPPED = "skipped (resume)"
 
 #: the scalar columns, in the order of ``catalogue.csv`` (``param_*``/``stderr_*``, then
 #: ``albedo_*``/``peak_ratio_*`` follow)
 COLUMNS = ("file", "channel", "model", "status", "error", "sigma", "rms_log", "aic", "bic",
            "n_points", "n_excluded", "elapsed_s", "sha256", "fit_dir", "figure", "limits",
-           "search_limits", "max_albedo", "gains_energy", "peak_ratio")
+           "search_limits", "max_albedo", "gains_energy", "peak_ratio", "earlier_status")
 #: the per-incidence columns of ``catalogue.csv``: row key -> column prefix
 BY_INCIDENCE = {"albedo": "albedo_", "peak_ratios": "peak_ratio_"}
 
@@ -110,10 +117,55 @@ def _plausibility_fields(res: FitResult, i: int) -> dict[str, Any]:
 
 def failed_row(file: str, model: str, error: str, *, sha256: str | None,
                elapsed_s: float | None = None, channel: str | None = None) -> dict[str, Any]:
-    """The row of a file (or channel) that failed with ``error``."""
+    """The row of a file (or channel) that failed with ``error`` (made one line:
+    :func:`one_line`, so that ``failed: FILE: error`` is one line whatever the error says)."""
     row = _empty(file, model, sha256)
-    row.update(status="failed", error=error, elapsed_s=elapsed_s, channel=channel)
+    row.update(status="failed", error=one_line(error), elapsed_s=elapsed_s, channel=channel)
     return row
+
+
+def outcome(row: dict[str, Any]) -> str | None:
+    """The status ``row`` counts as for the exit status: its own, or for a row kept by
+    ``--resume`` (:data:`SKIPPED`) the status it had when it was fitted (None: not recorded,
+    a row of an older catalogue)."""
+    if row.get("status") == SKIPPED:
+        return row.get("earlier_status")
+    return row.get("status")
+
+
+def shown_name(name: Any) -> str:
+    r"""A file name as one-line messages show it: as it is, or quoted like a Python string
+    literal (``'a\nb.csv'``) when it holds a character that is not printable (a newline, a
+    tab, an escape ...), so that the message stays one line and the name can be told exactly.
+
+    Examples
+    --------
+    >>> print(shown_name("a\tb.csv"), shown_name("\x1b[31mred.csv"))
+    'a\tb.csv' '\x1b[31mred.csv'
+    """
+    text = str(name)
+    # str.isprintable is False for every control, format and line/paragraph separator
+    # character (and for spaces other than " "): all of them are shown escaped
+    return text if text.isprintable() else repr(text)
+
+
+def one_line(text: Any, names: Sequence[Any] = ()) -> str:
+    r"""``text`` as one line: each of ``names`` (file names it may contain) shown by
+    :func:`shown_name`, runs of white space made one space, any other control character
+    escaped (``\x1b``).
+
+    Examples
+    --------
+    >>> one_line("cannot read /d/a\nb.csv:\n  line 3", names=["/d/a\nb.csv"])
+    "cannot read '/d/a\\nb.csv': line 3"
+    """
+    out = str(text)
+    for name in sorted({str(n) for n in names if n}, key=len, reverse=True):
+        out = out.replace(name, shown_name(name))  # longest first: a path before its tail
+    out = " ".join(out.split())
+    if out.isprintable():  # the common case: nothing left to escape
+        return out
+    return "".join(ch if ch.isprintable() else repr(ch)[1:-1] for ch in out)
 
 
 def fit_rows(res: FitResult, file: str, *, fit_dir: str, figures: Sequence[str | None],

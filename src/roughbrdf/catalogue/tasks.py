@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 from ..jsonsafe import clean_json
 from ..models.factory import is_auto
 from .resume import TASK_FILE, file_sha256
-from .rows import failed_row, fit_rows
+from .rows import failed_row, fit_rows, one_line
 
 if TYPE_CHECKING:
     from ..fitting.options import FitOptions
@@ -70,7 +70,9 @@ def run_task(task: Task) -> list[dict[str, Any]]:
     try:
         return _fit_and_save(task, sha, t0)
     except Exception as exc:  # a bad file or a failed fit: reported, the others go on
-        text = " ".join(str(exc).split()) or type(exc).__name__
+        # one line whatever the error says; the file's name (as given, or the absolute path
+        # the reader saw) quoted when it holds a newline, a tab, an escape ...
+        text = one_line(exc, names=(task.path, task.file)) or type(exc).__name__
         return [failed_row(task.file, task.label, f"{type(exc).__name__}: {text}", sha256=sha,
                            elapsed_s=time.perf_counter() - t0)]
 

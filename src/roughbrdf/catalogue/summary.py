@@ -57,8 +57,9 @@ from urllib.parse import quote, urlsplit
 import numpy as np
 
 from ..output import ResultFolder, ensure_folder, refuse_existing
+from .rows import one_line, shown_name
 
-__all__ = ["write_summary", "STATUSES", "SUMMARY_FILES"]
+__all__ = ["write_summary", "md_text", "STATUSES", "SUMMARY_FILES"]
 
 #: the pages :func:`write_summary` writes
 SUMMARY_FILES = ("summary.md", "summary.html")
@@ -111,10 +112,39 @@ def _href(path: Any) -> str | None:
     return quote(text, safe="/")
 
 
-def _md_cell(value: Any) -> str:
-    """``value`` for a Markdown table cell: HTML-escaped, pipes and line breaks neutralized."""
-    text = "" if value is None else str(value)
-    return html.escape(" ".join(text.split())).replace("|", "\\|")
+#: the ASCII punctuation a Markdown renderer acts on (CommonMark, and GitHub's tables, ``~``
+#: strikethrough): inline (emphasis, code, links, images, escapes, table cells) or at the
+#: start of a line (headings, lists, block quotes, thematic breaks). ``<``, ``>`` and ``&``
+#: (raw HTML, autolinks, entities) are written as HTML entities instead
+_MD_ACTIVE = "\\`*_{}[]()#+-.!|~"
+_MD_ESCAPES = str.maketrans({c: "\\" + c for c in _MD_ACTIVE})
+
+
+def md_text(value: Any) -> str:
+    r"""``value`` as literal Markdown text on one line: a renderer shows it as it is and makes
+    no link, image, emphasis, code, HTML, heading, list or table cell of it.
+
+    The one escaping of the summary's Markdown (file names, channels, errors, the title):
+    line breaks and control characters made one line (:func:`~roughbrdf.catalogue.rows.one_line`),
+    ``<``, ``>``, ``&`` as entities, every other active punctuation character
+    (:data:`_MD_ACTIVE`) backslash-escaped (CommonMark lets any ASCII punctuation be escaped).
+
+    Examples
+    --------
+    >>> print(md_text("[x](javascript:alert(9)).astm"))
+    \[x\]\(javascript:alert\(9\)\)\.astm
+    >>> print(md_text("<b>*a*_b_</b>"))
+    &lt;b&gt;\*a\*\_b\_&lt;/b&gt;
+    """
+    text = one_line("" if value is None else value)
+    # the entities first: their own "&" and ";" are not among the characters escaped next
+    return html.escape(text, quote=False).translate(_MD_ESCAPES)
+
+
+def _md_name(value: Any) -> str:
+    """A file name for the Markdown page: quoted when it holds control characters
+    (:func:`~roughbrdf.catalogue.rows.shown_name`), then :func:`md_text`."""
+    return md_text(None if value is None else shown_name(value))
 
 
 def _fmt(value: Any) -> str:
@@ -284,7 +314,8 @@ def _html_page(rows: Sequence[Mapping[str, Any]], title: str, page_size: int,
     counts = "".join(f"<tr><td>{html.escape(s)}</td><td>{c}</td></tr>" for s, c in _counts(rows))
     fails = _failures(rows)
     fail_items = "".join(
-        f"<li><b>{html.escape(str(r.get('file')))}</b> · {html.escape(str(r.get('channel')))}: "
+        f"<li><b>{html.escape(shown_name(r.get('file')))}</b> · "
+        f"{html.escape(str(r.get('channel')))}: "
         f"{html.escape(str(r.get('error') or r.get('status')))}</li>"
         for r in fails[:_MAX_FAILURES])
     more = (f"<li>… and {len(fails) - _MAX_FAILURES} more (filter the table)</li>"
@@ -315,27 +346,27 @@ def _html_page(rows: Sequence[Mapping[str, Any]], title: str, page_size: int,
 def _markdown(rows: Sequence[Mapping[str, Any]], title: str, page_size: int) -> str:
     """The whole ``summary.md``."""
     params = _param_names(rows)
-    lines = [f"# {_md_cell(title)}", "",
+    lines = [f"# {md_text(title)}", "",
              f"{len(rows)} fits (file × channel). Sortable, filterable table, parameter plots and "
              "contact sheet: [summary.html](summary.html).", "",
              "| status | fits |", "|---|---:|"]
-    lines += [f"| {_md_cell(s)} | {c} |" for s, c in _counts(rows)]
+    lines += [f"| {md_text(s)} | {c} |" for s, c in _counts(rows)]
     lines += ["", "## Failures", ""]
     fails = _failures(rows)
-    lines += [f"- **{_md_cell(r.get('file'))}** · {_md_cell(r.get('channel'))}: "
-              f"{_md_cell(r.get('error') or r.get('status'))}"
+    lines += [f"- **{_md_name(r.get('file'))}** · {md_text(r.get('channel'))}: "
+              f"{md_text(r.get('error') or r.get('status'))}"
               for r in fails[:_MAX_FAILURES]] or ["None."]
     if len(fails) > _MAX_FAILURES:
         lines.append(f"- … and {len(fails) - _MAX_FAILURES} more (filter the HTML table)")
     shown = rows[:max(1, int(page_size))]
     lines += ["", f"## Fits (first {len(shown)} of {len(rows)})", ""]
     head = ["file", "channel", "model", "status", "rms log", "BIC", "max albedo", *params]
-    lines += ["| " + " | ".join(_md_cell(h) for h in head) + " |",
+    lines += ["| " + " | ".join(md_text(h) for h in head) + " |",
               "|" + "---|" * 4 + "---:|" * (len(head) - 4)]
     for r in shown:
-        name, link = _md_cell(r.get("file")), _href(r.get("fit_dir"))
-        cells = [f"[{name}]({link})" if link else name, _md_cell(r.get("channel")),
-                 _md_cell(r.get("model")), _md_cell(r.get("status")), _fmt(r.get("rms_log")),
+        name, link = _md_name(r.get("file")), _href(r.get("fit_dir"))
+        cells = [f"[{name}]({link})" if link else name, md_text(r.get("channel")),
+                 md_text(r.get("model")), md_text(r.get("status")), _fmt(r.get("rms_log")),
                  _fmt(r.get("bic")), _fmt(r.get("max_albedo")),
                  *(_fmt((r.get("params") or {}).get(p)) for p in params)]
         lines.append("| " + " | ".join(cells) + " |")

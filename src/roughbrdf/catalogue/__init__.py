@@ -32,7 +32,8 @@ from typing import TYPE_CHECKING, Any
 from ..errors import ArgumentError
 from ..models.factory import as_model, is_auto, model_label
 from ..output import LOCK, MANIFEST
-from .resume import completed_rows, file_sha256, fingerprint
+from .resume import completed_rows, file_sha256, fingerprint, without_own_outputs
+from .rows import outcome
 from .tasks import Task
 
 if TYPE_CHECKING:
@@ -76,8 +77,9 @@ class CatalogueResult:
 
     @property
     def success(self) -> bool:
-        """No row failed or did not converge."""
-        return all(r["status"] in ("ok", "skipped (resume)") for r in self.rows)
+        """Every row is ``ok``; a row kept by ``--resume`` counts as the status it had when
+        it was fitted (:func:`~roughbrdf.catalogue.rows.outcome`)."""
+        return all(outcome(r) == "ok" for r in self.rows)
 
 
 def expand_inputs(inputs: str | os.PathLike | Iterable[str | os.PathLike]) -> list[str]:
@@ -241,8 +243,13 @@ def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model
     fit_opts = check_options(model, fit_options, read_options=read_options,
                              time_limit=time_limit, retries=retries, n_workers=n_workers,
                              options=options)
-    files = expand_inputs(inputs)
     out = Path(out_dir)
+    # the catalogue's own files are never inputs (`fit-batch IN --out IN`, with or without
+    # --resume): they would be "fitted" and fail
+    files = without_own_outputs(expand_inputs(inputs), out, RESERVED)
+    if not files:
+        raise ArgumentError("inputs", "no input files found (besides the catalogue's own)",
+                            value=os.fspath(out))
     # the fingerprint of --resume: the options of `options` that differ from the defaults and
     # the keywords as given (a keyword call fingerprints as it did before FitOptions existed)
     given = {**({} if options is None else options.changed()), **fit_options}
@@ -259,7 +266,7 @@ def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model
         cat.check(own)
         for i, (f, name) in enumerate(zip(files, folder_names(files), strict=True)):
             folder = out / name
-            rows = completed_rows(folder, file_sha256(f), fp) if resume else None
+            rows = completed_rows(folder, file_sha256(f), fp, file=f) if resume else None
             if rows is not None:
                 kept[i] = rows
                 continue

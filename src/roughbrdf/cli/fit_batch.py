@@ -9,10 +9,12 @@ results stops the command before any work unless ``--force`` (replace) or ``--re
 the inputs whose complete results exist for the same input bytes, model and options; redo the
 rest). ``--time-limit S`` fails a task that runs longer than S seconds.
 
-Exit status 1 when a file failed (its error is printed, the others are fitted) or a fit is not
-to be trusted without a look: it did not converge, a parameter ended on a search limit or the
-model gains energy (row statuses ``not converged``, ``at-search-limit``, ``gains-energy``);
-130 on Ctrl-C (finished fit folders are complete, no catalogue file is written).
+Exit status 0 when every row is ``ok``; 1 when a file failed (its error is printed, the others
+are fitted) or a fit is not to be trusted without a look: it did not converge, a parameter
+ended on a search limit or the model gains energy (row statuses ``not converged``,
+``at-search-limit``, ``gains-energy``). A row ``--resume`` kept (``skipped (resume)``) counts as
+the status it had when it was fitted (``earlier_status``). 130 on Ctrl-C (finished fit folders
+are complete, no catalogue file is written).
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ import typer
 
 from .common import handled
 from .fit import OPTIONS, resolve_model
-from .options import ModelInput, command, fit_options
+from .options import ModelInput, check_search, command, fit_options
 
 if TYPE_CHECKING:
     from ..fitting.options import FitOptions
@@ -63,39 +65,6 @@ def read_options(quantity: str | None, angles_in: str | None,
                              f"{', '.join(FORMATS)})") from None
         opts["format"] = file_format
     return opts
-
-
-def check_search(starts: int, loss: str, seed: int, relative_to: str | None = None) -> None:
-    """``--starts``, ``--loss``, ``--seed`` and ``--relative-to`` in the terms of the command
-    line, before any cluster starts (the library's own check,
-    :func:`roughbrdf.catalogue.check_options`, words them for Python and runs next, for every
-    other option).
-
-    Examples
-    --------
-    >>> check_search(0, "relative", 0)
-    Traceback (most recent call last):
-    ...
-    ValueError: --starts must be >= 1 (got 0)
-    """
-    from ..quantity import LOSSES, Loss, Quantity
-
-    if starts < 1:
-        raise ValueError(f"--starts must be >= 1 (got {starts})")
-    try:  # the loss's own check, worded for the command line
-        if loss != "auto":
-            Loss.parse(loss)
-    except ValueError:
-        raise ValueError(f"--loss: unknown value {loss!r} (choose from auto, "
-                         f"{', '.join(LOSSES)})") from None
-    if seed < 0:  # numpy's generators take no negative seed
-        raise ValueError(f"--seed must be >= 0 (got {seed})")
-    if relative_to is not None:
-        try:  # what a relative file's values are proportional to (fitting.data.Comparison)
-            Quantity.RELATIVE.compared_with(relative_to)
-        except ValueError:
-            raise ValueError(f"--relative-to: unknown value {relative_to!r} (choose from brdf, "
-                             f"bridf)") from None
 
 
 @dataclass(frozen=True)
@@ -137,12 +106,14 @@ def run_batch(paths: list[str], out: str, given: ModelInput, options: FitOptions
                         read_options=run.read, candidates=given.models, cv=run.cv,
                         time_limit=run.time_limit, progress=None if not run.quiet else False,
                         options=options)
+    from ..catalogue.rows import outcome, shown_name
+
     files = {r["file"] for r in res.rows}
-    for r in res.failed:
-        typer.echo(f"failed: {r['file']}: {r['error']}", err=True)
-    bad = {r["file"] for r in res.rows if r["status"] == "not converged"}
+    for r in res.failed:  # one line each, whatever the name holds (a newline, an escape)
+        typer.echo(f"failed: {shown_name(r['file'])}: {r['error']}", err=True)
+    bad = {r["file"] for r in res.rows if outcome(r) == "not converged"}
     for f in sorted(bad):
-        typer.echo(f"not converged: {f}", err=True)
+        typer.echo(f"not converged: {shown_name(f)}", err=True)
     kept = sum(r["status"] == "skipped (resume)" for r in res.rows)
     typer.echo(f"{len(files)} files, {len(res.rows)} rows ({len(res.failed)} failed, "
                f"{kept} kept from an earlier run); wrote "
@@ -195,7 +166,7 @@ def register(app: typer.Typer) -> None:
                                         values["file_format"]))
             run.check()
             check_search(values["starts"], values["loss"], values["seed"],
-                         values["relative_to"])
+                         values["relative_to"])  # before the model is built
             code = run_batch(values["paths"], values["out"], ModelInput.of(values),
                              fit_options(values), run)
         if code:

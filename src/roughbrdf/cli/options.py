@@ -23,8 +23,8 @@ import typer
 if TYPE_CHECKING:
     from ..fitting.options import FitOptions
 
-__all__ = ["TABLE", "ModelInput", "ReadInput", "channel_labels", "check_aperture", "command",
-           "fit_domain", "fit_options"]
+__all__ = ["TABLE", "ModelInput", "ReadInput", "channel_labels", "check_aperture",
+           "check_search", "command", "fit_domain", "fit_options"]
 
 # the options of model choice, joint fits and the fit domain, shared with `roughbrdf compare`
 ModelsOption = Annotated[str | None, typer.Option(
@@ -147,6 +147,44 @@ def check_aperture(aperture: float | None) -> float | None:
     return math.radians(aperture)
 
 
+def check_search(starts: int | None, loss: str | None, seed: int | None,
+                 relative_to: str | None = None) -> None:
+    """``--starts``, ``--loss``, ``--seed`` and ``--relative-to`` in the terms of the command
+    line, for every verb that fits (:func:`fit_options` calls it), before any work: each
+    error names its option and the value (numpy would say "expected non-negative integer" of
+    a negative seed, naming nothing). None: the verb has no such option.
+
+    Examples
+    --------
+    >>> check_search(0, "relative", 0)
+    Traceback (most recent call last):
+    ...
+    ValueError: --starts must be >= 1 (got 0)
+    >>> check_search(8, "auto", -1)
+    Traceback (most recent call last):
+    ...
+    ValueError: --seed must be >= 0 (got -1)
+    """
+    from ..quantity import LOSSES, Loss, Quantity
+
+    if starts is not None and starts < 1:  # no start point, no fit
+        raise ValueError(f"--starts must be >= 1 (got {starts})")
+    try:  # the loss's own check, worded for the command line
+        if loss is not None and loss != "auto":
+            Loss.parse(loss)
+    except ValueError:
+        raise ValueError(f"--loss: unknown value {loss!r} (choose from auto, "
+                         f"{', '.join(LOSSES)})") from None
+    if seed is not None and seed < 0:  # numpy's generators take no negative seed
+        raise ValueError(f"--seed must be >= 0 (got {seed})")
+    if relative_to is not None:
+        try:  # what a relative file's values are proportional to (fitting.data.Comparison)
+            Quantity.RELATIVE.compared_with(relative_to)
+        except ValueError:
+            raise ValueError(f"--relative-to: unknown value {relative_to!r} (choose from brdf, "
+                             f"bridf)") from None
+
+
 def fit_domain(theta_r_max: float | None, source_exclusion: float | None
                ) -> tuple[float | None, float | None]:
     """``--theta-r-max``, ``--source-exclusion`` (degrees) -> radians, checked by the library
@@ -161,9 +199,11 @@ def fit_options(values: Mapping[str, Any], *, progress: bool | None = None) -> F
     """The :class:`~roughbrdf.fitting.options.FitOptions` of a verb's values, without
     ``--fix`` and ``--bounds`` (they need the model: :func:`roughbrdf.cli.fit.resolve_model`):
     angles in degrees checked and turned into radians, ``--keep-extrapolated`` as
-    ``extrapolated``."""
+    ``extrapolated``; the search options checked in CLI terms (:func:`check_search`)."""
     from ..fitting.options import FitOptions
 
+    check_search(values.get("starts"), values.get("loss"), values.get("seed"),
+                 values.get("relative_to"))
     aperture = check_aperture(values.get("aperture"))
     t_max, excl = fit_domain(values.get("theta_r_max"), values.get("source_exclusion"))
     given = {k: values[k] for k in _AS_GIVEN if k in values}

@@ -205,6 +205,9 @@ class _Loop:
         self.channels = self.failures = 0
         self.local = False
         self.unfinished: list[Task] = []
+        #: fit folders of tasks whose worker was killed under them (time limit, a death):
+        #: tidied at the end, when those processes are gone
+        self.killed: list[str] = []
 
     def run(self, client: Any) -> None:
         from distributed import wait
@@ -233,6 +236,7 @@ class _Loop:
             return
         exc = fut.exception()
         self.tries[i] += 1
+        self.killed.append(task.folder)  # a retry's own ResultFolder also recovers it
         if self.tries[i] <= self.retries:  # the worker died under it (or the task broke)
             self.queue.appendleft((i, task))
             return
@@ -250,6 +254,7 @@ class _Loop:
         for fut in late:
             i, task, t0 = self.running.pop(fut)
             fut.cancel()
+            self.killed.append(task.folder)  # its worker is restarted mid-write below
             self._record(i, [failed_row(task.file, task.label,
                                         f"time limit of {self.time_limit:g} s exceeded",
                                         sha256=None, elapsed_s=now - t0)])
@@ -279,6 +284,10 @@ class _Loop:
         if self.local:
             for task in self.unfinished:
                 tidy(task.folder)
+        # the workers restarted or dead under a task: their locks and temporary files (a
+        # live process's are never touched: tidy judges each by its process id)
+        for folder in dict.fromkeys(self.killed):
+            tidy(folder)
 
 
 def _workers_of(client: Any, futures: list[Any]) -> set[str]:

@@ -149,6 +149,8 @@ def check_result_folder(folder: str | os.PathLike, *,
     # process that no longer exists, is taken over below if recovery needs it)
     if os.path.lexists(lock) and not lock_is_stale(lock):
         raise ResultFolderRefused(path, "locked", options=options)
+    # a journal: a write was cut off, and the files may be a mix until it is rolled forward
+    # or back (without one, nothing is taken: a reader's lock could fail a writer's commit)
     recovered = _recover(path, options) if os.path.lexists(path / JOURNAL) else []
     try:
         listed = read_manifest(path)
@@ -160,7 +162,7 @@ def check_result_folder(folder: str | os.PathLike, *,
         if digest is None or not os.path.lexists(path / name):
             continue
         actual = file_sha256(path / name)
-        if actual != digest:
+        if actual != digest:  # not the bytes roughbrdf committed (or not readable at all)
             kind = "unreadable" if actual is None else "changed"
             raise ResultFolderRefused(path, kind, name, options=options)
     return recovered

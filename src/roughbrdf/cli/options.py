@@ -202,8 +202,9 @@ def fit_options(values: Mapping[str, Any], *, progress: bool | None = None) -> F
     ``extrapolated``; the search options checked in CLI terms (:func:`check_search`)."""
     from ..fitting.options import FitOptions
 
-    check_search(values.get("starts"), values.get("loss"), values.get("seed"),
-                 values.get("relative_to"))
+    # --relative-to is left to the library here: fit and compare name it (with the value and
+    # the choices); fit-batch checks it too, before any cluster starts
+    check_search(values.get("starts"), values.get("loss"), values.get("seed"))
     aperture = check_aperture(values.get("aperture"))
     t_max, excl = fit_domain(values.get("theta_r_max"), values.get("source_exclusion"))
     given = {k: values[k] for k in _AS_GIVEN if k in values}

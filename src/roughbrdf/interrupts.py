@@ -28,6 +28,15 @@ raising it, so that a late Ctrl-C cannot turn a finished run into a traceback.
 :func:`checkpoint` marks the statements of that tail: a no-op unless a test installed a hook
 (:func:`set_checkpoint_hook`) that sends the signal there.
 
+The requests to stop that a program receives from outside the terminal end it the same way:
+inside :func:`watch`, SIGTERM (``timeout``, a batch system such as SLURM, systemd) and SIGHUP
+(the terminal closed) are handled as SIGINT is (:data:`SIGNALS`): they raise
+``KeyboardInterrupt``, are held by :func:`held_interrupts` and recorded by
+:func:`record_interrupts`, so that every clean-up of Ctrl-C (locks released, temporary files
+removed, a cluster's workers stopped) runs for them too. :func:`interrupt_signal` tells which
+one came first (the command line exits with 128 + its number). Outside :func:`watch` only SIGINT
+is handled, as Python does.
+
 Examples
 --------
 >>> with held_interrupts():
@@ -47,14 +56,22 @@ from collections.abc import Callable, Iterator
 from typing import Any
 
 __all__ = ["held_interrupts", "watch", "interrupted", "raise_if_interrupted",
-           "record_interrupts", "late_interrupts", "checkpoint", "set_checkpoint_hook"]
+           "record_interrupts", "late_interrupts", "checkpoint", "set_checkpoint_hook",
+           "interrupt_signal", "ignore_interrupts", "SIGNALS"]
+
+#: the signals that end a program run inside :func:`watch`: Ctrl-C, and the requests to stop
+#: of ``timeout``, a batch system or a service manager (SIGTERM) and of a closed terminal
+#: (SIGHUP, which Windows does not have)
+SIGNALS: tuple[int, ...] = tuple(
+    getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))
 
 _depth = 0
-_pending: list[Any] = []
+_pending: list[int] = []  # the signals held by held_interrupts(), in order
 _watching = 0
 _seen = False
+_received: list[int] = []  # the first signal that interrupted the current watch() block
 _hooks: list[Any] = []  # the unraisable hook that watch() replaced
-_late: list[int] = []  # SIGINTs recorded after record_interrupts()
+_late: list[int] = []  # signals recorded after record_interrupts()
 _checkpoint_hook: list[Callable[[str], None]] = []  # test-only (set_checkpoint_hook)
 
 
@@ -66,19 +83,32 @@ def _in_main_thread() -> bool:
     return threading.current_thread() is threading.main_thread()
 
 
+def _held_signals() -> list[int]:
+    """The signals :func:`held_interrupts` defers: SIGINT (whatever Python handler it has), and
+    the other :data:`SIGNALS` while :func:`watch` handles them (outside it their handler is not
+    ours: SIGTERM's default ends the process, and files are recovered by the next run)."""
+    held = [signal.SIGINT]
+    held += [s for s in SIGNALS[1:] if signal.getsignal(s) is _on_signal]
+    return held
+
+
 @contextlib.contextmanager
 def held_interrupts() -> Iterator[None]:
-    """Defer SIGINT during the block; raise ``KeyboardInterrupt`` after it if one came (or,
-    inside :func:`watch`, if one was swallowed earlier)."""
+    """Defer SIGINT during the block (and, inside :func:`watch`, SIGTERM and SIGHUP); raise
+    ``KeyboardInterrupt`` after it if one came (or, inside :func:`watch`, if one was swallowed
+    earlier)."""
     global _depth
     if _depth or not _in_main_thread() or signal.getsignal(signal.SIGINT) is None:
         # nested: the outer block delivers; other threads never receive signals; a handler
         # installed outside Python could not be put back
         yield
         return
+    previous: dict[int, Any] = {}
     try:
-        previous = signal.signal(signal.SIGINT, _record)
+        for signum in _held_signals():
+            previous[signum] = signal.signal(signum, _record)
     except (ValueError, OSError):  # no signal handling here (e.g. an embedded interpreter)
+        _put_back(previous)
         yield
         return
     _depth = 1
@@ -86,18 +116,25 @@ def held_interrupts() -> Iterator[None]:
         yield
     finally:
         _depth = 0
-        signal.signal(signal.SIGINT, previous)
+        _put_back(previous)
         if _pending:
+            first = _pending[0]
             _pending.clear()
-            _deliver(previous)
+            _deliver(previous[first], first)
         elif _seen:
             raise KeyboardInterrupt
 
 
-def _deliver(handler: Any) -> None:
-    """Act on a SIGINT that arrived while held, as ``handler`` would have."""
+def _put_back(handlers: dict[int, Any]) -> None:
+    """Install ``handlers`` (``{signal: handler}``) again."""
+    for signum, handler in handlers.items():
+        signal.signal(signum, handler)
+
+
+def _deliver(handler: Any, signum: int = signal.SIGINT) -> None:
+    """Act on a signal that arrived while held, as ``handler`` would have."""
     if callable(handler):  # the handler that was in place (Python's raises)
-        handler(signal.SIGINT, None)
+        handler(signum, None)
     elif handler != signal.SIG_IGN:
         raise KeyboardInterrupt
 
@@ -105,9 +142,11 @@ def _deliver(handler: Any) -> None:
 # --------------------------------------------------------------------------------------------
 # programs that must end on Ctrl-C
 # --------------------------------------------------------------------------------------------
-def _on_sigint(signum: int, frame: Any) -> None:
+def _on_signal(signum: int, frame: Any) -> None:
     global _seen
     _seen = True
+    if not _received:  # the first one is the cause; a second only repeats the request
+        _received.append(signum)
     raise KeyboardInterrupt
 
 
@@ -122,43 +161,76 @@ def _unraisable(info: Any) -> None:
     hook(info)
 
 
+def _install(handler: Any) -> dict[int, Any]:
+    """Install ``handler`` for the :data:`SIGNALS` :func:`watch` handles; ``{signal: the
+    handler it replaced}``. SIGINT always (as Python does; also when a shell started the
+    program with it ignored, a background job); SIGTERM and SIGHUP only where they have their
+    default action: an ignored one (``nohup``) or a caller's Python handler stays as it is."""
+    previous = {signal.SIGINT: signal.signal(signal.SIGINT, handler)}
+    for signum in SIGNALS[1:]:
+        if signal.getsignal(signum) is signal.SIG_DFL:
+            previous[signum] = signal.signal(signum, handler)
+    return previous
+
+
 @contextlib.contextmanager
 def watch() -> Iterator[None]:
-    """Run a program's block so that Ctrl-C always ends it (see the module docstring).
+    """Run a program's block so that Ctrl-C, SIGTERM and SIGHUP always end it (see the module
+    docstring).
 
-    SIGINT raises ``KeyboardInterrupt`` as usual and is also recorded; an interrupt that some
-    library swallowed is raised again by the next :func:`held_interrupts` block,
+    Each of :data:`SIGNALS` raises ``KeyboardInterrupt`` (as SIGINT does in Python) and is
+    recorded (:func:`interrupt_signal`); an interrupt that some library swallowed is raised
+    again by the next :func:`held_interrupts` block,
     :meth:`~roughbrdf.output.ResultFolder.commit` or :func:`raise_if_interrupted`. Only acts in
-    the main thread; nests (the outer block is the one that counts).
+    the main thread; nests (the outer block is the one that counts). On exit the caller's
+    handlers are back.
     """
     global _watching, _seen
     if _watching or not _in_main_thread() or signal.getsignal(signal.SIGINT) is None:
         yield
         return
     try:
-        previous = signal.signal(signal.SIGINT, _on_sigint)
-    except (ValueError, OSError):
+        previous = _install(_on_signal)
+    except (ValueError, OSError):  # no signal handling here (e.g. an embedded interpreter)
         yield
         return
     _hooks.append(sys.unraisablehook)
     sys.unraisablehook = _unraisable
     _watching, _seen = 1, False
     _late.clear()
+    _received.clear()
     try:
         yield
     finally:
         _watching, _seen = 0, False
         _late.clear()
+        _received.clear()
         sys.unraisablehook = _hooks.pop()
-        # put the caller's handler back (last: from here a SIGINT is the caller's), unless the
-        # block replaced ours (the command line's SIG_IGN)
-        if signal.getsignal(signal.SIGINT) in (_on_sigint, _record_late):
-            signal.signal(signal.SIGINT, previous)
+        # put the caller's handlers back (last: from here a signal is the caller's), unless
+        # the block replaced ours (the command line's SIG_IGN, ignore_interrupts)
+        for signum, handler in previous.items():
+            if signal.getsignal(signum) in (_on_signal, _record_late):
+                signal.signal(signum, handler)
 
 
 def interrupted() -> bool:
-    """Whether Ctrl-C was pressed inside the current :func:`watch` block."""
+    """Whether Ctrl-C (or SIGTERM, SIGHUP) came inside the current :func:`watch` block."""
     return _seen
+
+
+def interrupt_signal() -> int:
+    """The number of the first of :data:`SIGNALS` that interrupted the current :func:`watch`
+    block; ``signal.SIGINT`` when none did (a ``KeyboardInterrupt`` raised otherwise, or a
+    Ctrl-C outside :func:`watch`).
+
+    Examples
+    --------
+    >>> import signal
+    >>> with watch():
+    ...     interrupt_signal() == signal.SIGINT
+    True
+    """
+    return _received[0] if _received else int(signal.SIGINT)
 
 
 def raise_if_interrupted() -> None:
@@ -172,21 +244,42 @@ def _record_late(signum: int, frame: Any) -> None:
 
 
 def record_interrupts() -> None:
-    """From now until the :func:`watch` block ends, record SIGINT instead of raising it.
+    """From now until the :func:`watch` block ends, record SIGINT (SIGTERM, SIGHUP) instead of
+    raising it.
 
     For the end of a program whose work is done: a Ctrl-C there changes nothing
-    (:func:`late_interrupts` tells whether one came). A SIGINT that was already pending when
+    (:func:`late_interrupts` tells whether one came). A signal that was already pending when
     this is called is raised first (``signal.signal`` runs pending handlers before it replaces
     them), so it counts as one that came before. Only acts inside :func:`watch` (outside it,
     Python's own handling is left as it is) and in the main thread.
     """
-    # outside watch() the handler is the caller's: not ours to change; other threads cannot
-    if _watching and _in_main_thread() and signal.getsignal(signal.SIGINT) is _on_sigint:
-        signal.signal(signal.SIGINT, _record_late)
+    # outside watch() the handlers are the caller's: not ours to change; other threads cannot
+    if _watching and _in_main_thread():
+        for signum in SIGNALS:
+            if signal.getsignal(signum) is _on_signal:
+                signal.signal(signum, _record_late)
+
+
+def ignore_interrupts() -> None:
+    """Ignore SIGINT from now on, and SIGTERM and SIGHUP where :func:`watch` handles them.
+
+    For the very end of a program (the console script, once its status is known): only
+    Python's shutdown is left, which a signal could only turn into a death by that signal. The
+    :func:`watch` block leaves them ignored when it ends. Only acts in the main thread.
+    """
+    if not _in_main_thread():  # signal.signal works in the main thread only
+        return
+    for signum in SIGNALS:
+        # SIGINT as the command line always did; the others only where watch() installed ours
+        # (an ignored SIGHUP or a caller's SIGTERM handler is not ours to change)
+        if signum == signal.SIGINT or signal.getsignal(signum) in (_on_signal, _record_late):
+            with contextlib.suppress(ValueError, OSError):  # no signal handling here
+                signal.signal(signum, signal.SIG_IGN)
 
 
 def late_interrupts() -> int:
-    """How many SIGINTs came after :func:`record_interrupts` in the current :func:`watch`."""
+    """How many of :data:`SIGNALS` came after :func:`record_interrupts` in the current
+    :func:`watch`."""
     return len(_late)
 
 

@@ -15,10 +15,14 @@ Exit statuses
       a file is expected or a file where a folder is expected
 4     internal error (a bug in roughbrdf: ``--debug`` shows the traceback)
 130   interrupted (Ctrl-C); nothing half-written is left behind
+143   stopped by SIGTERM (``timeout``, SLURM, systemd): the same clean-up as Ctrl-C
+129   stopped by SIGHUP (the terminal closed): the same clean-up as Ctrl-C
 ====  ==========================================================================================
 
 Every error is one line on stderr naming what is wrong (``roughbrdf --debug VERB ...`` adds the
-traceback); an interrupt prints ``interrupted``.
+traceback); an interrupt prints ``interrupted`` (``interrupted (SIGTERM)``, ...: the signal
+when it is not Ctrl-C), and exits with 128 + the signal's number, as a shell reports a process
+that the signal ended (:func:`interrupted_status`).
 """
 
 from __future__ import annotations
@@ -34,14 +38,36 @@ if TYPE_CHECKING:
     app: typer.Typer
 
 __all__ = ["app", "main", "build_app", "get_app", "VERBS", "EXIT_OK", "EXIT_NOT_CONVERGED",
-           "EXIT_USAGE", "EXIT_OS", "EXIT_BUG", "EXIT_INTERRUPTED"]
+           "EXIT_USAGE", "EXIT_OS", "EXIT_BUG", "EXIT_INTERRUPTED", "interrupted_status",
+           "interrupt_line"]
 
 EXIT_OK = 0
 EXIT_NOT_CONVERGED = 1
 EXIT_USAGE = 2
 EXIT_OS = 3
 EXIT_BUG = 4
-EXIT_INTERRUPTED = 130
+EXIT_INTERRUPTED = 130  # 128 + SIGINT; SIGTERM and SIGHUP give 143 and 129
+
+
+def interrupted_status() -> int:
+    """The exit status of a run that a signal interrupted: 128 + its number (130 for Ctrl-C,
+    143 for SIGTERM, 129 for SIGHUP: :func:`roughbrdf.interrupts.interrupt_signal`)."""
+    from ..interrupts import interrupt_signal
+
+    return 128 + interrupt_signal()
+
+
+def interrupt_line() -> str:
+    """The one line an interrupted run prints: ``interrupted``, naming the signal when it is
+    not Ctrl-C (``interrupted (SIGTERM)``)."""
+    import signal
+
+    from ..interrupts import interrupt_signal
+
+    signum = interrupt_signal()
+    if signum == signal.SIGINT:
+        return "interrupted"
+    return f"interrupted ({signal.Signals(signum).name})"
 
 #: modules under roughbrdf.cli that register verbs (each defines register(app))
 VERBS = ["evaluate", "fit", "fit_batch", "compare", "export", "convert", "plot", "reproduce"]
@@ -110,15 +136,16 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line (``argv``, default ``sys.argv[1:]``); returns the exit status.
 
     Ctrl-C at any moment of the run ends it with :data:`EXIT_INTERRUPTED` and the one line
-    ``interrupted`` (also when a library swallowed the ``KeyboardInterrupt``:
+    ``interrupted``; SIGTERM and SIGHUP likewise, with 143 and 129 (:func:`interrupted_status`;
+    also when a library swallowed the ``KeyboardInterrupt``:
     :func:`roughbrdf.interrupts.watch`). Once the run's status is settled (its files are
     committed), a Ctrl-C changes nothing: :func:`main` returns that status and never raises
     ``KeyboardInterrupt`` (:func:`roughbrdf.interrupts.record_interrupts`). As the console
-    script (``argv`` None), a Ctrl-C that comes after :func:`main` has returned is ignored: only
-    Python's shutdown is left. Called from Python, the caller's SIGINT handler is back once
-    :func:`main` returns.
+    script (``argv`` None), a Ctrl-C (SIGTERM, SIGHUP) that comes after :func:`main` has returned
+    is ignored: only Python's shutdown is left. Called from Python, the caller's handlers are
+    back once :func:`main` returns.
     """
-    from ..interrupts import checkpoint, record_interrupts, watch
+    from ..interrupts import checkpoint, ignore_interrupts, record_interrupts, watch
 
     Run.debug = "--debug" in (sys.argv[1:] if argv is None else argv)  # until parsed
     Run.interrupt_reported = False
@@ -126,16 +153,16 @@ def main(argv: list[str] | None = None) -> int:
         try:
             code = _run(argv)  # returns with SIGINT recorded, never raised
         except KeyboardInterrupt:  # only where _run did not settle (a second Ctrl-C there)
-            code = EXIT_INTERRUPTED
+            code = interrupted_status()
             record_interrupts()
         checkpoint("main: status settled")
-        if code == EXIT_INTERRUPTED and not Run.interrupt_reported:
-            _say("interrupted")
+        if code == interrupted_status() and not Run.interrupt_reported:
+            _say(interrupt_line())
             checkpoint("main: interrupted said")
             Run.interrupt_reported = True
         checkpoint("main: reported")
         if argv is None:
-            _ignore_sigint()
+            ignore_interrupts()
             checkpoint("main: SIGINT ignored")
         return code
 
@@ -168,8 +195,9 @@ def _one_line_warnings() -> Iterator[None]:
 def _run(argv: list[str] | None) -> int:
     """Run the command; its exit status, settled: on return SIGINT is recorded, not raised.
 
-    A Ctrl-C that comes before the status is settled (while the command runs, or in the few
-    statements after it, which are still this function's) makes it :data:`EXIT_INTERRUPTED`.
+    A Ctrl-C (SIGTERM, SIGHUP) that comes before the status is settled (while the command runs,
+    or in the few statements after it, which are still this function's) makes it
+    :func:`interrupted_status`.
     """
     from ..interrupts import checkpoint, interrupted, record_interrupts
 
@@ -177,16 +205,16 @@ def _run(argv: list[str] | None) -> int:
         code = _invoke(argv)
         checkpoint("run: command returned")
         if interrupted():  # a Ctrl-C that a library swallowed during the command
-            code = EXIT_INTERRUPTED
+            code = interrupted_status()
     except KeyboardInterrupt:
-        code = EXIT_INTERRUPTED
+        code = interrupted_status()
     while True:
         try:
             checkpoint("run: settling")
             record_interrupts()
             return code
         except KeyboardInterrupt:  # it came before the handler was replaced: try again
-            code = EXIT_INTERRUPTED
+            code = interrupted_status()
 
 
 def _invoke(argv: list[str] | None) -> int:
@@ -215,11 +243,3 @@ def _say(line: str) -> None:
     except (OSError, ValueError):  # stderr closed or a broken pipe: nothing more to do
         pass
 
-
-def _ignore_sigint() -> None:
-    import signal
-
-    try:
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-    except (ValueError, OSError):
-        pass

@@ -6,9 +6,10 @@ the models, SciPy, Matplotlib are imported inside the functions that use them), 
 
 Every verb runs its work inside :func:`handled`, which turns an exception into one line on
 stderr and the exit status of :mod:`roughbrdf.cli` (2 usage or input, 3 operating system, 4 a
-bug, 130 interrupted), names CLI options in library errors about arguments
-(:class:`roughbrdf.errors.ArgumentError`, :class:`roughbrdf.output.OverwriteRefused`) and shows
-the traceback only with ``roughbrdf --debug``.
+bug, 130 interrupted; 143 and 129 for SIGTERM and SIGHUP), names CLI options in library
+errors about arguments (:class:`roughbrdf.errors.ArgumentError`,
+:class:`roughbrdf.output.OverwriteRefused`) and shows the traceback only with
+``roughbrdf --debug``.
 
 Each verb has its table of options here (:data:`FIT_OPTIONS`, :data:`CONVERT_OPTIONS`, ...):
 library messages in Python terms (``starts must be >= 1``, ``pass format=``, ``angles='deg'``)
@@ -28,7 +29,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from . import EXIT_BUG, EXIT_INTERRUPTED, EXIT_OS, EXIT_USAGE, Run
+from . import EXIT_BUG, EXIT_OS, EXIT_USAGE, Run, interrupt_line, interrupted_status
 
 if TYPE_CHECKING:
     import numpy as np
@@ -98,7 +99,8 @@ def handled(options: Mapping[str, str] | None = None) -> Iterator[None]:
         for :class:`~roughbrdf.output.OverwriteRefused`).
 
     Ctrl-C ends the run with status 130 and ``interrupted``, also when a library swallowed it
-    (:func:`roughbrdf.interrupts.watch`).
+    (:func:`roughbrdf.interrupts.watch`); SIGTERM and SIGHUP the same way, with 143 and 129
+    (:func:`roughbrdf.cli.interrupted_status`).
     """
     from ..interrupts import raise_if_interrupted, watch
 
@@ -110,8 +112,8 @@ def handled(options: Mapping[str, str] | None = None) -> Iterator[None]:
             raise
         except KeyboardInterrupt as exc:
             Run.interrupt_reported = True
-            typer.echo("interrupted", err=True)
-            raise typer.Exit(EXIT_INTERRUPTED) from exc
+            typer.echo(interrupt_line(), err=True)
+            raise typer.Exit(interrupted_status()) from exc
         except BrokenPipeError as exc:  # stdout's reader went away (`| head`): nothing to say
             _silence_stdout()
             raise typer.Exit(EXIT_OS) from exc
@@ -146,8 +148,8 @@ def exit_status(exc: BaseException) -> int:
     """
     from ..output import OverwriteRefused
 
-    if isinstance(exc, KeyboardInterrupt):
-        return EXIT_INTERRUPTED
+    if isinstance(exc, KeyboardInterrupt):  # 130, or 128 + the SIGTERM/SIGHUP that raised it
+        return interrupted_status()
     if isinstance(exc, OverwriteRefused | FileNotFoundError | ValueError | TypeError):
         return EXIT_USAGE
     if isinstance(exc, OSError | MemoryError):

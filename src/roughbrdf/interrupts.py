@@ -87,7 +87,7 @@ def _held_signals() -> list[int]:
     """The signals :func:`held_interrupts` defers: SIGINT (whatever Python handler it has), and
     the other :data:`SIGNALS` while :func:`watch` handles them (outside it their handler is not
     ours: SIGTERM's default ends the process, and files are recovered by the next run)."""
-    held = [signal.SIGINT]
+    held: list[int] = [signal.SIGINT]
     held += [s for s in SIGNALS[1:] if signal.getsignal(s) is _on_signal]
     return held
 
@@ -166,7 +166,7 @@ def _install(handler: Any) -> dict[int, Any]:
     handler it replaced}``. SIGINT always (as Python does; also when a shell started the
     program with it ignored, a background job); SIGTERM and SIGHUP only where they have their
     default action: an ignored one (``nohup``) or a caller's Python handler stays as it is."""
-    previous = {signal.SIGINT: signal.signal(signal.SIGINT, handler)}
+    previous: dict[int, Any] = {signal.SIGINT: signal.signal(signal.SIGINT, handler)}
     for signum in SIGNALS[1:]:
         if signal.getsignal(signum) is signal.SIG_DFL:
             previous[signum] = signal.signal(signum, handler)

@@ -58,5 +58,8 @@ def test_ks_at_1_is_a_physical_limit_not_a_search_limit():
     assert c.limits == {"ks": "physical-upper"}
     # the same value reached with a wider, non-physical search range is not a limit at all
     wide = rb.fit("microfacet", bright, starts=2, progress=False, bounds={"ks": (0.0, 20.0)})
-    assert wide.channels[0].limits == {}
+    # ks is on no limit; k may end on its physical lower bound 0 (the truth's k = 0: where it
+    # ends, 0 or 1e-9 above, is the optimizer's path, not the physics)
+    assert "ks" not in wide.channels[0].limits
+    assert set(wide.channels[0].limits.items()) <= {("k", "physical-lower")}
     assert wide.channels[0].params["ks"] > 1.0

@@ -17,17 +17,25 @@ IMM-REP-1999-05).
 Converged means the model with the bounds predicts no worthwhile decrease: the undamped
 bounded step from the point lowers ``m`` by at most ``tol`` times the cost. This holds at a
 minimum in the interior (the gradient vanishes) and at one on the bounds (the gradient points
-out of the box), and fails at a point that only stopped moving.
+out of the box), and fails at a point that only stopped moving. Or the point is first-order
+optimal (:func:`~roughbrdf.fitting.stationary.optimality` at most
+:data:`~roughbrdf.fitting.stationary.GTOL`: a stationary point where a Jacobian column
+vanishes, which the predicted decrease does not see). Flat parameters do not move
+(:func:`~roughbrdf.fitting.stationary.flat`), and the end is settled on the bounds it is as
+good on (:func:`~roughbrdf.fitting.stationary.snap`): ``docs/fitting.md``, "The same answer
+on every machine".
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..interrupts import held_interrupts
 from .objective import Objective
+from .stationary import GTOL, flat, optimality, scaling, snap
 
 __all__ = ["BoundedResult", "GaussNewtonModel", "bounded_lm", "bounded_step"]
 
@@ -162,18 +170,23 @@ def bounded_lm(obj: Objective, x0: np.ndarray, tol: float, max_nfev: int | None 
         njev += 1
         model = GaussNewtonModel.of(jac, f)  # factored once for every trial step below
         d2 = np.maximum(d2, np.sum(jac * jac, axis=0))
-        # a column of zeros (a parameter the residuals do not depend on) gets unit scaling
-        scale2 = np.where(d2 > 0, d2, 1.0)
-        if model.step(x, lo, hi)[1] <= tol * cost:
-            return BoundedResult(x, cost, 1, "the bounded Gauss-Newton step predicts a "
-                                 f"decrease below {tol:g} of the cost", nfev, njev)
+        scale2 = scaling(d2, f, x, lo, hi)  # floored (stationary.scaling)
+        frozen = flat(jac, f, x, lo, hi)
+        # the step's box: a flat parameter keeps its value (module notes)
+        slo, shi = np.where(frozen, x, lo), np.where(frozen, x, hi)
+        if model.step(x, slo, shi)[1] <= tol * cost:
+            return _settled(obj, x, cost, 1, "the bounded Gauss-Newton step predicts a "
+                            f"decrease below {tol:g} of the cost", nfev, njev)
+        if optimality(jac, f, x, lo, hi, scale2, frozen=frozen) <= GTOL:
+            return _settled(obj, x, cost, 1, "first-order optimal (the projected gradient "
+                            f"within {GTOL:g} of the scaled columns)", nfev, njev)
         while True:
             if nfev >= budget:
-                return BoundedResult(x, cost, 0, "the evaluation budget (max_nfev) is used "
-                                     "up", nfev, njev)
+                return _settled(obj, x, cost, 0, "the evaluation budget (max_nfev) is used "
+                                "up", nfev, njev)
             if lam > LAMBDA_MAX:
-                return BoundedResult(x, cost, 3, "no step lowers the cost", nfev, njev)
-            p, pred = model.step(x, lo, hi, lam * scale2)
+                return _settled(obj, x, cost, 3, "no step lowers the cost", nfev, njev)
+            p, pred = model.step(x, slo, shi, lam * scale2)
             x_new = np.clip(x + p, lo, hi)  # round-off of x + p past a bound
             f_new = obj.fun(x_new)
             nfev += 1
@@ -186,3 +199,15 @@ def bounded_lm(obj: Objective, x0: np.ndarray, tol: float, max_nfev: int | None 
                 break
             lam *= nu
             nu *= 2.0
+
+
+def _settled(obj: Objective, x: np.ndarray, cost: float, status: int, message: str,
+             nfev: int, njev: int) -> BoundedResult:
+    """The result at ``x``, its parameters near a bound tried on it first
+    (:func:`~roughbrdf.fitting.stationary.snap`)."""
+    def trial(z: np.ndarray) -> float:
+        r = obj.fun(z)
+        return 0.5 * float(r @ r) if np.all(np.isfinite(r)) else math.inf
+
+    x, cost, n = snap(x, cost, obj.spec.lower, obj.spec.upper, trial)
+    return BoundedResult(x, cost, status, message, nfev + n, njev)

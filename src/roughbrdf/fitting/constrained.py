@@ -29,6 +29,7 @@ steps zigzag: it stopped on its evaluation budget on small synthetic TR75 sets.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -37,6 +38,7 @@ import numpy as np
 from ..interrupts import held_interrupts
 from .bounded import LAMBDA_MAX, BoundedResult, GaussNewtonModel
 from .objective import Objective
+from .stationary import GTOL, flat, optimality, scaling, snap
 
 __all__ = ["BAD_LIMIT", "FEASIBLE", "Limits", "constrained_lm", "finite_limits", "lsi_step",
            "violation"]
@@ -187,46 +189,100 @@ def constrained_lm(obj: Objective, limits: Limits, x0: np.ndarray, tol: float,
         njev += 1
         model = GaussNewtonModel.of(jac, f)  # factored once for every trial step below
         d2 = np.maximum(d2, np.sum(jac * jac, axis=0))
-        scale2 = np.where(d2 > 0, d2, 1.0)  # a parameter the residuals ignore: unit scaling
-        h = -g
-        test = lsi_step(model, TEST_DAMPING * scale2, lo - x, hi - x, gmat, h)
+        scale2 = scaling(d2, f, x, lo, hi)  # floored (stationary.scaling)
+        # the step's box: a flat parameter keeps its value (stationary.flat)
+        frozen = flat(jac, f, x, lo, hi, gmat, FEASIBLE)
+        slo, shi = np.where(frozen, 0.0, lo - x), np.where(frozen, 0.0, hi - x)
+        test = lsi_step(model, TEST_DAMPING * scale2, slo, shi, gmat, -g)
         if test is not None:
             rho = max(rho, 2.0 * float(np.max(test[1], initial=0.0)))
-            # feasible, and the step that keeps the linearized constraints predicts no
-            # worthwhile decrease of the cost (the merit's violation part is within FEASIBLE,
-            # and nearly dependent active constraints can make rho, and so it, large)
-            if violation(g) <= FEASIBLE and _predicted(model, test[0], g, gmat, 0.0) <= \
-                    tol * max(cost, 1e-300):
-                return BoundedResult(x, cost, 1, "the constrained Gauss-Newton step "
-                                     f"predicts a decrease below {tol:g} of the cost", nfev,
-                                     njev)
+            done = _converged(model, test, jac, f, x, g, gmat, scale2, frozen, obj, tol, cost)
+            if done is not None:
+                return _settled(obj, limits, x, cost, 1, done, nfev, njev)
         while True:
             if nfev >= budget:
-                return BoundedResult(x, cost, 0, "the evaluation budget (max_nfev) is used "
-                                     "up", nfev, njev)
+                return _settled(obj, limits, x, cost, 0, "the evaluation budget (max_nfev) "
+                                "is used up", nfev, njev)
             if lam > LAMBDA_MAX:
-                return BoundedResult(x, cost, 3, "no step lowers the cost and the "
-                                     "constraint violation", nfev, njev)
-            step = _relaxed_step(model, lam * scale2, lo - x, hi - x, gmat, g)
+                return _settled(obj, limits, x, cost, 3, "no step lowers the cost and the "
+                                "constraint violation", nfev, njev)
+            step = _relaxed_step(model, lam * scale2, slo, shi, gmat, g)
             if step is None:
-                return BoundedResult(x, cost, 4, "the linearized constraints cannot be met "
-                                     "within the bounds", nfev, njev)
+                return _settled(obj, limits, x, cost, 4, "the linearized constraints cannot "
+                                "be met within the bounds", nfev, njev)
             p, mu = step
             rho = max(rho, 2.0 * float(np.max(mu, initial=0.0)))
             pred = _predicted(model, p, g, gmat, rho)
-            x_new = np.clip(x + p, lo, hi)  # round-off of x + p past a bound
-            f_new, g_new = obj.fun(x_new), finite_limits(limits.values(x_new))
+            trial = _Trial.at(obj, limits, np.clip(x + p, lo, hi))  # round-off past a bound
             nfev += 1
-            cost_new = 0.5 * float(f_new @ f_new)
-            actual = _merit(cost, g, rho) - _merit(cost_new, g_new, rho)
-            gain = actual / pred if pred > 0 else -1.0
+            merit0 = _merit(cost, g, rho)
+            if not merit0 - trial.merit(rho) > 0 and violation(trial.g) > violation(g):
+                # the constraints' curvature made the step infeasible (the Maratos effect):
+                # the second-order correction, the step's linearization moved to its end
+                soc = lsi_step(model, lam * scale2, slo, shi, gmat, gmat @ p - trial.g)
+                if soc is not None:
+                    trial = _Trial.at(obj, limits, np.clip(x + soc[0], lo, hi))
+                    nfev += 1
+            gain = (merit0 - trial.merit(rho)) / pred if pred > 0 else -1.0
             if gain > 0:  # accepted: Nielsen's update
                 lam *= max(1.0 / 3.0, 1.0 - (2.0 * gain - 1.0) ** 3)
                 nu = 2.0
-                x, f, g, cost = x_new, f_new, g_new, cost_new
+                x, f, g, cost = trial.x, trial.f, trial.g, trial.cost
                 break
             lam *= nu
             nu *= 2.0
+
+
+@dataclass(frozen=True)
+class _Trial:
+    """A trial point: its residuals, constraint values and cost."""
+
+    x: np.ndarray
+    f: np.ndarray
+    g: np.ndarray
+    cost: float
+
+    @classmethod
+    def at(cls, obj: Objective, limits: Limits, x: np.ndarray) -> _Trial:
+        f = obj.fun(x)
+        return cls(x, f, finite_limits(limits.values(x)), 0.5 * float(f @ f))
+
+    def merit(self, rho: float) -> float:
+        return _merit(self.cost, self.g, rho)
+
+
+def _converged(model: GaussNewtonModel, test: tuple[np.ndarray, np.ndarray], jac: np.ndarray,
+               f: np.ndarray, x: np.ndarray, g: np.ndarray, gmat: np.ndarray, d2: np.ndarray,
+               frozen: np.ndarray, obj: Objective, tol: float, cost: float) -> str | None:
+    """Why ``x`` is a constrained minimum (module notes), or None: feasible, and the nearly
+    undamped step that keeps the linearized constraints predicts no worthwhile decrease, or the
+    Lagrangian's projected gradient is first-order optimal
+    (:func:`~roughbrdf.fitting.stationary.optimality`, the test step's multipliers)."""
+    if violation(g) > FEASIBLE:
+        return None
+    # the merit's violation part is within FEASIBLE (nearly dependent active constraints can
+    # make rho, and so it, large): the data part alone decides
+    if _predicted(model, test[0], g, gmat, 0.0) <= tol * max(cost, 1e-300):
+        return f"the constrained Gauss-Newton step predicts a decrease below {tol:g} of the cost"
+    extra = gmat.T @ test[1] if gmat.size else None
+    if optimality(jac, f, x, obj.spec.lower, obj.spec.upper, d2, extra, frozen) <= GTOL:
+        return f"first-order optimal (the projected gradient within {GTOL:g} of the scaled " \
+               "columns)"
+    return None
+
+
+def _settled(obj: Objective, limits: Limits, x: np.ndarray, cost: float, status: int,
+             message: str, nfev: int, njev: int) -> BoundedResult:
+    """The result at ``x``, its parameters near a bound tried on it first where the point
+    stays as feasible (:func:`~roughbrdf.fitting.stationary.snap`)."""
+    allowed = max(FEASIBLE, violation(finite_limits(limits.values(x))))
+
+    def trial(z: np.ndarray) -> float | None:
+        t = _Trial.at(obj, limits, z)
+        return t.cost if violation(t.g) <= allowed and math.isfinite(t.cost) else None
+
+    x, cost, n = snap(x, cost, obj.spec.lower, obj.spec.upper, trial)
+    return BoundedResult(x, cost, status, message, nfev + n, njev)
 
 
 def _predicted(model: GaussNewtonModel, p: np.ndarray, g: np.ndarray, gmat: np.ndarray,

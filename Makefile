@@ -5,7 +5,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed-$(shell cat pyproject.toml | cksum | cut -d' ' -f1)
 
-.PHONY: demo test bench lint clean venv browser
+.PHONY: demo test test-avx2 bench lint clean venv browser
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -39,6 +39,19 @@ browser:
 # the suite (tests/), every docstring example in src/ and the README's examples (pyproject.toml)
 test: $(STAMP) browser
 	$(PY) -m pytest -q -p no:cacheprovider
+
+# The tests whose outcome could hang on the kernels' rounding (every fit of the shared paints and
+# the solvers), run again with the kernels compiled for an AVX2 processor without AVX-512 and
+# OpenBLAS's Haswell kernels, as on such a machine (docs/fitting.md, "The same answer on every
+# machine"). NUMBA_CPU_FEATURES is set empty on purpose: numba otherwise keeps the host's
+# features (AVX-512) under NUMBA_CPU_NAME=haswell. A machine's own OPENBLAS_CORETYPE stands.
+ROUNDING_TESTS := tests/test_auto_energy.py tests/test_energy_constraint.py \
+	tests/test_fitting_real.py tests/test_constrained.py tests/test_bounded.py \
+	tests/test_fitting.py tests/test_compare.py tests/test_fit_limits.py \
+	tests/test_fit_energy.py tests/test_fit_scale_hold.py tests/test_same_answer.py
+test-avx2: $(STAMP)
+	NUMBA_CPU_NAME=haswell NUMBA_CPU_FEATURES= OPENBLAS_CORETYPE=$${OPENBLAS_CORETYPE:-Haswell} \
+	  $(PY) -m pytest -q -p no:cacheprovider $(ROUNDING_TESTS)
 
 # BENCH_ARGS: e.g. --skip-worker-memory (the slow worker-memory figure), or benchmark names
 bench: $(STAMP)

@@ -28,8 +28,11 @@ on every machine".
 
 from __future__ import annotations
 
+import copy
 import math
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
@@ -37,7 +40,7 @@ from ..interrupts import held_interrupts
 from .objective import Objective
 from .stationary import GTOL, flat, optimality, scaling, snap
 
-__all__ = ["BoundedResult", "GaussNewtonModel", "bounded_lm", "bounded_step"]
+__all__ = ["BoundedResult", "GaussNewtonModel", "bounded_lm", "bounded_step", "settle"]
 
 #: Nielsen's initial damping, relative to Marquardt's scaling ``D^2``
 LAMBDA0 = 1e-3
@@ -205,9 +208,40 @@ def _settled(obj: Objective, x: np.ndarray, cost: float, status: int, message: s
              nfev: int, njev: int) -> BoundedResult:
     """The result at ``x``, its parameters near a bound tried on it first
     (:func:`~roughbrdf.fitting.stationary.snap`)."""
+    x, cost, n = snap(x, cost, obj.spec.lower, obj.spec.upper, _cost_of(obj))
+    return BoundedResult(x, cost, status, message, nfev + n, njev)
+
+
+def _cost_of(obj: Objective) -> Callable[[np.ndarray], float]:
     def trial(z: np.ndarray) -> float:
         r = obj.fun(z)
         return 0.5 * float(r @ r) if np.all(np.isfinite(r)) else math.inf
+    return trial
 
-    x, cost, n = snap(x, cost, obj.spec.lower, obj.spec.upper, trial)
-    return BoundedResult(x, cost, status, message, nfev + n, njev)
+
+def settle(obj: Objective, res: Any) -> Any:
+    """A local fit's result (``scipy.optimize.OptimizeResult`` or :class:`BoundedResult`)
+    with its end settled on the bounds it is as good on
+    (:func:`~roughbrdf.fitting.stationary.snap`); ``res`` itself when nothing moved.
+
+    Examples
+    --------
+    >>> import roughbrdf as rb
+    >>> from roughbrdf.fitting import ChannelData
+    >>> from roughbrdf.fitting.objective import ObjectiveSpec
+    >>> spec = ObjectiveSpec(rb.model("lambertian", rho=0.9), ["rho"], [0.0], [1.0],
+    ...                      loss="absolute")
+    >>> data = ChannelData.from_arrays([0.1, 0.3], [0.2, 0.4], [0.0, 1.0], [0.0, 0.0])
+    >>> res = BoundedResult(np.array([1e-9]), 1e-19, 1, "", 1, 1)
+    >>> float(settle(Objective(spec, data), res).x[0])        # rho = 0 fits the zeros
+    0.0
+    """
+    x, cost, n = snap(np.asarray(res.x, dtype=float), float(res.cost), obj.spec.lower,
+                      obj.spec.upper, _cost_of(obj))
+    if n == 0 or np.array_equal(x, res.x):
+        return res
+    if isinstance(res, BoundedResult):
+        return replace(res, x=x, cost=cost, nfev=res.nfev + n)
+    out = copy.copy(res)
+    out.x, out.cost, out.nfev = x, cost, int(res.nfev) + n
+    return out

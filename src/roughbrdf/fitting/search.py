@@ -28,15 +28,15 @@ import numpy as np
 
 from ..errors import ArgumentError
 from ..interrupts import held_interrupts
-from .bounded import bounded_lm
+from .bounded import bounded_lm, settle
 from .objective import Objective, ObjectiveSpec
 
 if TYPE_CHECKING:
     from .data import ChannelData
 
 __all__ = ["MultiStart", "SearchOptions", "SearchOutcome", "local_fit", "polish_fit",
-           "progress_bar", "screen", "sobol_points", "EXPLORE_TOL", "POLISH_TOL",
-           "POLISH_ROUND", "SCREEN_DIST"]
+           "progress_bar", "screen", "sobol_points", "CHOICE_TOL", "EXPLORE_TOL", "POLISH_TOL",
+           "POLISH_ROUND", "SCREEN_DIST", "first_best"]
 
 #: tolerance (ftol, xtol, gtol) of the exploring local fits
 EXPLORE_TOL = 1e-4
@@ -50,6 +50,11 @@ POLISH_ROUND = 100
 SCREEN_DIST = 0.15
 #: end points of the exploration closer than this (in units of the bounds) are one point
 DISTINCT_END = 1e-3
+#: end points whose costs differ by at most this fraction are equally good: the first (in the
+#: order of the starts) is kept, so that rounding (1e-13 of a cost between AVX2 and AVX-512
+#: kernels) cannot choose between them. Not more: the exploring fits of a small channel end
+#: by ``ftol`` (EXPLORE_TOL), 1e-8 apart, and the lowest of them is the nearest the optimum
+CHOICE_TOL = 1e-12
 X_SCALE = "jac"
 
 
@@ -194,8 +199,8 @@ def polish_fit(obj: Objective, x0: np.ndarray, max_nfev: int | None) -> Any:
     while True:
         res = local_fit(obj, x, POLISH_TOL, min(POLISH_ROUND, budget - used))
         used += int(res.nfev)
-        if res.status != 0 or used >= budget:
-            return res
+        if res.status != 0 or used >= budget:  # its end settled on the bounds (as bounded_lm's)
+            return settle(obj, res)
         # the bounded steps only accept decreases: their end is never worse than trf's
         res = bounded_lm(obj, res.x, POLISH_TOL, min(POLISH_ROUND, budget - used))
         used += res.nfev
@@ -235,18 +240,37 @@ def search(full: Objective, explore: Objective, starts: list[np.ndarray],
         ends.append((float(res.cost), res.x, res))
         if on_start is not None:
             on_start()
-    ends.sort(key=lambda e: e[0])
-    if single:
-        return SearchOutcome(ends[0][1], ends[0][2], tried, 0)
-    chosen = _distinct([e[1] for e in ends], options.polish, hi - lo)
-    best_cost, best_x, best = math.inf, chosen[0], None
+    if single:  # the first end as good as the best (first_best), in the order of the starts
+        first = settle(full, ends[first_best([e[0] for e in ends])][2])
+        return SearchOutcome(first.x, first, tried, 0)
+    order = sorted(range(len(ends)), key=lambda i: ends[i][0])
+    keep = _distinct([ends[i][1] for i in order], options.polish, hi - lo)
+    # polished in the order of their starts, so that first_best's choice follows the starts
+    chosen = [ends[i][1] for i in sorted(i for i in order if any(ends[i][1] is x for x in keep))]
+    polished = []
     for xe in chosen:
         res = polish_fit(full, xe, options.max_nfev)
         tried.append({"x0": xe.tolist(), "x": res.x.tolist(), "cost": float(res.cost),
                       "stage": "full", "origin": "explored"})
-        if res.cost < best_cost:
-            best_cost, best_x, best = float(res.cost), res.x, res
-    return SearchOutcome(best_x, best, tried, explore.nfev)
+        polished.append(res)
+    best = polished[first_best([float(r.cost) for r in polished])]
+    return SearchOutcome(best.x, best, tried, explore.nfev)
+
+
+def first_best(costs: list[float]) -> int:
+    """The index of the first cost within :data:`CHOICE_TOL` of the lowest (NaN: worst).
+
+    Examples
+    --------
+    >>> first_best([3.0, 1.0000000000001, 1.0])   # the second and third are equally good
+    1
+    """
+    finite = [c for c in costs if math.isfinite(c)]
+    if not finite:
+        return 0
+    low = min(finite)
+    return next(i for i, c in enumerate(costs)
+                if math.isfinite(c) and c <= low + CHOICE_TOL * abs(low))
 
 
 class MultiStart:

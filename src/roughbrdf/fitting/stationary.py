@@ -139,8 +139,8 @@ def optimality(jac: np.ndarray, f: np.ndarray, x: np.ndarray, lower: np.ndarray,
 
 def snap(x: np.ndarray, cost: float, lower: np.ndarray, upper: np.ndarray,
          trial: Callable[[np.ndarray], float | None]) -> tuple[np.ndarray, float, int]:
-    """Each parameter within :data:`SNAP_DIST` of its box of a bound, in order, tried on the
-    bound: kept when ``trial(x_new)`` (the cost there, None when the point is refused, e.g.
+    """Each parameter within :data:`SNAP_DIST` of its box of a bound (and of the bound itself,
+    but for a bound 0), in order, tried on the bound: kept when ``trial(x_new)`` (the cost there, None when the point is refused, e.g.
     infeasible) is at most ``(1 + SNAP_COST) cost``. Returns the point, its cost and the
     trials made.
 
@@ -157,7 +157,12 @@ def snap(x: np.ndarray, cost: float, lower: np.ndarray, upper: np.ndarray,
     n = 0
     for j in range(x.size):
         for b in (lower[j], upper[j]):
-            if not np.isfinite(b) or x[j] == b or abs(x[j] - b) > SNAP_DIST * w[j]:
+            # near: within SNAP_DIST of the box, and of the bound itself unless it is 0 (a
+            # bound far below the box's width, 1e-4 of [1e-4, 1], is a search over decades:
+            # 5e-3 is not near it, as for statistics.at_bound)
+            d = abs(x[j] - b)
+            if not np.isfinite(b) or d == 0 or d > SNAP_DIST * w[j] or (
+                    b != 0 and d > SNAP_DIST * abs(b)):
                 continue
             x_new = x.copy()
             x_new[j] = b

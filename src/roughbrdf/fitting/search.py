@@ -235,14 +235,16 @@ def search(full: Objective, explore: Objective, starts: list[np.ndarray],
     for p0, origin in zip(starts, origins, strict=True):
         p0 = np.clip(p0, lo, hi)
         res = local_fit(explore, p0, EXPLORE_TOL, options.max_nfev)
+        if single:  # an end of the search itself: settled on its bounds (bounded.settle)
+            res = settle(full, res)
         tried.append({"x0": p0.tolist(), "x": res.x.tolist(), "cost": float(res.cost),
                       "stage": "single" if single else "explore", "origin": origin})
         ends.append((float(res.cost), res.x, res))
         if on_start is not None:
             on_start()
     if single:  # the first end as good as the best (first_best), in the order of the starts
-        first = settle(full, ends[first_best([e[0] for e in ends])][2])
-        return SearchOutcome(first.x, first, tried, 0)
+        first = ends[first_best([e[0] for e in ends])]
+        return SearchOutcome(first[1], first[2], tried, 0)
     order = sorted(range(len(ends)), key=lambda i: ends[i][0])
     keep = _distinct([ends[i][1] for i in order], options.polish, hi - lo)
     # polished in the order of their starts, so that first_best's choice follows the starts

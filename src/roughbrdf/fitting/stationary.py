@@ -140,8 +140,9 @@ def optimality(jac: np.ndarray, f: np.ndarray, x: np.ndarray, lower: np.ndarray,
 def snap(x: np.ndarray, cost: float, lower: np.ndarray, upper: np.ndarray,
          trial: Callable[[np.ndarray], float | None]) -> tuple[np.ndarray, float, int]:
     """Each parameter within :data:`SNAP_DIST` of its box of a bound (and of the bound itself,
-    but for a bound 0), in order, tried on the bound: kept when ``trial(x_new)`` (the cost there, None when the point is refused, e.g.
-    infeasible) is at most ``(1 + SNAP_COST) cost``. Returns the point, its cost and the
+    but for a bound 0), in order, tried on the bound: kept when ``trial(x_new)`` (the cost
+    there, None when the point is refused, e.g. infeasible) is at most
+    ``(1 + SNAP_COST) cost``. Returns the point, its cost and the
     trials made.
 
     Examples

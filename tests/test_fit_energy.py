@@ -16,6 +16,7 @@ import roughbrdf as rb
 from roughbrdf.cli import main
 from roughbrdf.errors import ArgumentError
 from roughbrdf.fitting.plausibility import ALBEDO_INCIDENCES_DEG, EnergyWarning
+from roughbrdf.journal import MANIFEST
 
 GRID = np.radians(np.mgrid[0:61:30, 0:81:10, 0:181:45].reshape(3, -1))
 # ks inside its search range [0, 1]: a fit that ends on its bound 1 is on a search limit
@@ -168,6 +169,7 @@ def test_old_fit_json_still_plots_and_exports(data_file, tmp_path, capsys):
         for key in NEW_KEYS:
             del ch[key]
     path.write_text(json.dumps(content))
+    (out / MANIFEST).unlink()  # an older roughbrdf wrote no manifest (a folder of then)
     assert main(["plot", "--fit", str(out), "--out", str(tmp_path / "p.png")]) == 0, \
         capsys.readouterr()
     assert (tmp_path / "p.png").read_bytes().startswith(b"\x89PNG")

@@ -21,6 +21,7 @@ import pytest
 import roughbrdf as rb
 from roughbrdf.errors import ArgumentError
 from roughbrdf.fitting.load import InputChangedWarning
+from roughbrdf.journal import MANIFEST
 
 DATA = Path(__file__).parent / "data" / "zemax" / "AnoBlackNiTEonINVAR.bsdf"
 
@@ -39,6 +40,14 @@ def saved(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[rb.FitRes
         res.save(root / name, plots=False)
         out[name] = (res, root / name)
     return out
+
+
+def _hand_edit(folder: Path, doc: dict) -> None:
+    """Write ``doc`` as ``folder``'s fit.json as a folder written before manifests were: a
+    hand-edited fit.json beside the manifest is refused (its hash differs), which
+    tests/test_crash_readers.py covers; these tests are about what load_fit reads."""
+    (folder / "fit.json").write_text(json.dumps(doc))
+    (folder / MANIFEST).unlink()
 
 
 def _same(a: dict, b: dict) -> None:
@@ -99,7 +108,7 @@ def test_changed_input_warns(saved, tmp_path):
     res.save(fit, plots=False)
     doc = json.loads((fit / "fit.json").read_text())
     doc["file"] = doc["file_abspath"] = str(src)
-    (fit / "fit.json").write_text(json.dumps(doc))
+    _hand_edit(fit, doc)
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # the same bytes: no warning
         rb.load_fit(fit)
@@ -136,7 +145,7 @@ def test_relative_file_name_is_found_beside_the_fit(saved, tmp_path):
     shutil.copyfile(DATA, tmp_path / "fit" / "moved.bsdf")
     doc = json.loads((tmp_path / "fit" / "fit.json").read_text())
     doc["file"], doc["file_abspath"] = "moved.bsdf", None  # a relative name only
-    (tmp_path / "fit" / "fit.json").write_text(json.dumps(doc))
+    _hand_edit(tmp_path / "fit", doc)
     back = rb.load_fit(tmp_path / "fit")
     _same(back.params, res.params)
 
@@ -222,7 +231,7 @@ def test_nan_stderr_stays_nan(saved, tmp_path):
     doc = json.loads((tmp_path / "fit" / "fit.json").read_text())
     free = doc["channels"][0]["free"][0]
     doc["channels"][0]["stderr"][free] = None
-    (tmp_path / "fit" / "fit.json").write_text(json.dumps(doc))
+    _hand_edit(tmp_path / "fit", doc)
     back = rb.load_fit(tmp_path / "fit", measurement=res.measurement)
     assert math.isnan(back[0].stderr[free])
     fixed = [k for k in back[0].params if k not in back[0].free]

@@ -229,7 +229,8 @@ def test_resume_never_takes_a_half_committed_set_for_a_complete_one(tmp_path):
             p.write_bytes(b"")
         b, a = completed_rows(folder, "s", "B"), completed_rows(folder, "s", "A")
         if journal and staged:  # rolled back: the old, complete set A
-            assert b is None and a == [{"r": "A", "status": "skipped (resume)"}], k
+            assert b is None and a == [{"r": "A", "status": "skipped (resume)",
+                                        "earlier_status": None}], k
         else:
             assert (a is None) != (b is None), k
             if b is not None:
@@ -238,7 +239,8 @@ def test_resume_never_takes_a_half_committed_set_for_a_complete_one(tmp_path):
 
 def test_resume_does_not_take_a_truncated_fit_json_for_a_result(tmp_path):
     _task_set(tmp_path)
-    assert completed_rows(tmp_path, "s", "A") == [{"r": "A", "status": "skipped (resume)"}]
+    assert completed_rows(tmp_path, "s", "A") == [{"r": "A", "status": "skipped (resume)",
+                                                   "earlier_status": None}]
     (tmp_path / "fit.json").write_bytes(b"")
     assert completed_rows(tmp_path, "s", "A") is None
     _task_set(tmp_path / "edited")

@@ -2,8 +2,7 @@
 
 ``FitResult`` gives the fitted model as the fit compared it with the data
 (:meth:`FitResult.predict`, through the instrument aperture if the fit had one), the ``fit.json``
-content
-(:meth:`FitResult.to_dict`, :meth:`FitResult.to_json`), the text report
+content (:meth:`FitResult.to_dict`, :meth:`FitResult.to_json`), the text report
 (:mod:`roughbrdf.fitting.report`), the plots (:meth:`FitResult.plot`, drawn by
 :mod:`roughbrdf.plot` through the fit's aperture) and :meth:`FitResult.save`. The keys of
 ``fit.json`` are listed in ``docs/fitting.md`` ("Output files").
@@ -593,6 +592,9 @@ def channel_model(fit: dict[str, Any], chan: dict[str, Any]) -> Model:
 
 
 def fitted_models(fit: str | os.PathLike) -> dict[str, Model]:
-    """``{channel: fitted model}`` of a saved fit (``fit.json`` or its folder)."""
+    """``{channel: model}`` of a saved fit (``fit.json`` or its folder), checked as load_fit's."""
+    from ..result_check import check_result_folder
+
+    check_result_folder(fit if Path(fit).is_dir() else Path(fit).parent)
     content, _ = read_fit_json(fit)
     return {str(c["channel"]): channel_model(content, c) for c in content["channels"]}

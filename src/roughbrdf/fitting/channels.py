@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 from ..errors import ArgumentError
 from ..models.factory import as_model, spec_text
 from .data import ChannelData, prepare_channel
-from .energy import EnergyConstraint, conditional_covariance, constrain_channel
+from .energy import EnergyConstraint, conditional_covariance, constrain_channel, refit_constrained
 from .joint import fit_joint
 from .objective import ObjectiveSpec
 from .plan import FitPlan, channel_indices, check_enough_data
@@ -55,12 +55,15 @@ def refuse_polarimetric_weight(options: FitOptions) -> None:
 
 
 def fit_model(model: Model | str, measurement: Measurement, options: FitOptions, *,
-              check_energy: bool = True) -> FitResult:
+              check_energy: bool = True, refit: bool = False) -> FitResult:
     """Fit one model (an instance, a name or a spec; not ``"auto"``) with ``options``:
     Mueller data with :func:`~roughbrdf.fitting.polarimetric.fit_mueller`, others with
     :func:`fit_channels`. With ``check_energy``, an
     :class:`~roughbrdf.fitting.plausibility.EnergyWarning` for each channel whose fitted model
-    reflects more than it receives (the refits of a cross-validation skip the check)."""
+    reflects more than it receives (the refits of a cross-validation skip the check). With
+    ``refit`` (a cross-validation fold: ``model`` holds a fit's optimum), a channel fitted
+    under the energy constraint is refitted from that optimum under the constraint directly
+    (:func:`~roughbrdf.fitting.energy.refit_constrained`)."""
     res: FitResult
     if is_mueller(measurement):  # Mueller elements: all at once
         res = fit_mueller(model, measurement, options=options)
@@ -68,7 +71,7 @@ def fit_model(model: Model | str, measurement: Measurement, options: FitOptions,
         refuse_polarimetric_weight(options)
         m = as_model(model)
         res = (_by_wavelength(m, measurement, options) if needs_wavelength(m)
-               else fit_channels(m, measurement, options))
+               else fit_channels(m, measurement, options, refit=refit))
     if check_energy:
         warn_energy(res, stacklevel=4)
     return res
@@ -87,9 +90,10 @@ def _by_wavelength(model: Model, measurement: Measurement, options: FitOptions) 
                                elapsed=sum(r.elapsed for r in results))
 
 
-def fit_channels(model: Model, measurement: Measurement, options: FitOptions) -> FitResult:
+def fit_channels(model: Model, measurement: Measurement, options: FitOptions, *,
+                 refit: bool = False) -> FitResult:
     """Fit ``model`` to the channels of ``measurement`` (not Mueller data), each on its own
-    or, with ``options.joint``, all at once."""
+    or, with ``options.joint``, all at once; ``refit`` as :func:`fit_model`'s."""
     t_start = time.perf_counter()
     chans = channel_indices(measurement, options.channel)
     plan = FitPlan.of(model, measurement, options)
@@ -107,22 +111,33 @@ def fit_channels(model: Model, measurement: Measurement, options: FitOptions) ->
             results, summary = fit_joint(spec, data, search, options.shared, tick)
         else:
             results, summary = _separately(spec, search, data, bar, tick,
-                                           options.energy_constraint), None
+                                           options.energy_constraint, refit), None
     return FitResult(channels=results, **plan.result_fields(
         measurement, time.perf_counter() - t_start, joint=summary,
         energy_constraint=options.energy_constraint and not joint))
 
 
 def _separately(spec: ObjectiveSpec, search: SearchOptions, data: list[ChannelData],
-                bar: Any, tick: Any, energy: bool = True) -> list[ChannelFit]:
+                bar: Any, tick: Any, energy: bool = True, refit: bool = False
+                ) -> list[ChannelFit]:
     """Each channel on its own, in order (the previous optimum is a warm start); with
-    ``energy``, a channel whose model gains energy refitted under the constraint."""
+    ``energy``, a channel whose model gains energy refitted under the constraint; with
+    ``refit``, a model that cannot guarantee energy refitted from its values under the
+    constraint directly (:func:`~roughbrdf.fitting.energy.refit_constrained`)."""
     results: list[ChannelFit] = []
     runner = MultiStart(spec, search, tick)
     for d in data:
         t0 = time.perf_counter()
         if bar is not None:
             bar.set_postfix_str(d.label)
+        direct = None
+        if refit and energy and not spec.model.conserves_energy and d.n:
+            direct = refit_constrained(spec, d, runner.start, search.max_nfev)
+        if direct is not None:
+            full = runner.objectives(d)[0]
+            fit = ChannelFit.from_search(full, direct[0], time.perf_counter() - t0)
+            results.append(_constrained(fit, full, direct[1]))
+            continue
         obj, outcome = runner.run(d)
         info = None
         if energy:

@@ -346,7 +346,7 @@ def _fold(result: FitResult, options: FitOptions, train: Measurement, out: np.nd
             channel=[c.channel for c in group], starts=1, progress=False, subsample=None,
             joint=joint, shared=result.options["joint"]["shared"] if joint else None,
             weights=weights)
-        fold = fit_model(group[0].model, train, fold_options, check_energy=False)
+        fold = fit_model(group[0].model, train, fold_options, check_energy=False, refit=True)
         for c, fc in zip(group, fold.channels, strict=True):
             idx = c.index[out[c.index]]
             if idx.size == 0:

@@ -36,9 +36,13 @@ browser:
 	  fi; \
 	fi
 
-# the suite (tests/), every docstring example in src/ and the README's examples (pyproject.toml)
+# the suite (tests/), every docstring example in src/ and the README's examples (pyproject.toml),
+# in TEST_JOBS processes (pytest-xdist; one per core by default, TEST_JOBS=0 for one process:
+# the order of a plain run, e.g. to debug); --dist loadfile keeps a test file's tests (and its
+# module fixtures: the fits it shares) in one process
+TEST_JOBS ?= auto
 test: $(STAMP) browser
-	$(PY) -m pytest -q -p no:cacheprovider
+	$(PY) -m pytest -q -p no:cacheprovider -n $(TEST_JOBS) --dist loadfile
 
 # The tests whose outcome could hang on the kernels' rounding (every fit of the shared paints and
 # the solvers), run again with the kernels compiled for an AVX2 processor without AVX-512 and
@@ -51,7 +55,7 @@ ROUNDING_TESTS := tests/test_auto_energy.py tests/test_energy_constraint.py \
 	tests/test_fit_energy.py tests/test_fit_scale_hold.py tests/test_same_answer.py
 test-avx2: $(STAMP)
 	NUMBA_CPU_NAME=haswell NUMBA_CPU_FEATURES= OPENBLAS_CORETYPE=$${OPENBLAS_CORETYPE:-Haswell} \
-	  $(PY) -m pytest -q -p no:cacheprovider $(ROUNDING_TESTS)
+	  $(PY) -m pytest -q -p no:cacheprovider -n $(TEST_JOBS) --dist loadfile $(ROUNDING_TESTS)
 
 # BENCH_ARGS: e.g. --skip-worker-memory (the slow worker-memory figure), or benchmark names
 bench: $(STAMP)

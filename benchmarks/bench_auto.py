@@ -1,8 +1,8 @@
 """Model choice speed: ``rb.fit("auto")`` on one Mini-Diff file, and a single ``coated`` fit.
 
-Issue 20's budget: ``--model auto`` on one Mini-Diff file (3 channels, every candidate, the
-leave-one-incidence-out score and the energy constraint included) in at most 5 s warm on an
-AVX-512 machine and 15 s on a 2-core AVX2 one; a single ``coated`` fit in 1.5 s / 4 s.
+The budget: ``--model auto`` on one Mini-Diff file (3 channels, every candidate, the
+leave-one-incidence-out score and the energy constraint included) at most 6x one ``coated``
+fit of the same run (the ratio travels between machines; the absolute time does not).
 
 Printed, warm (the compiled kernels and the lobe-albedo tables built by a first run, not
 counted), best of :data:`REPEAT`: the default ``rb.fit("auto")``, and in the same run the
@@ -26,16 +26,12 @@ import roughbrdf as rb
 from roughbrdf.fitting.compare import fit_auto
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # run.py loads by path
-from machine import load, vector_width  # noqa: E402
+from machine import cpu_name, load, vector_width  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 DATA = Path(os.environ.get("ROUGHBRDF_SHARED_DATA", HERE.parent.parent / "shared" / "data"))
 FILE = "C2_Black"
 REPEAT = 2
-
-
-
-
 
 
 def best(call: Callable[[], object]) -> float:
@@ -56,7 +52,7 @@ def main() -> None:
         return
     meas = rb.read(path)
     warnings.simplefilter("ignore")  # the candidates' plausibility warnings are not timed
-    print(f"CPU vector unit: {vector_width()}; load average before: {load()}")
+    print(f"CPU: {cpu_name()}; vector unit: {vector_width()}; load average before: {load()}")
     runs = {
         "rb.fit('auto') (defaults: CV score, energy constraint)":
             lambda: rb.fit("auto", meas, progress=False),
@@ -64,15 +60,19 @@ def main() -> None:
             lambda: fit_auto(meas, cv=False, progress=False),
         "rb.fit('auto', energy_constraint=False) (reference)":
             lambda: rb.fit("auto", meas, energy_constraint=False, progress=False),
-        "rb.fit('coated') (one candidate)":
+        "rb.fit('coated') (one candidate: the reference of the ratios)":
             lambda: rb.fit("coated", meas, progress=False),
     }
     rb.fit("auto", meas, progress=False)  # warm: kernels compiled, tables built
     print(f"\n{FILE} ({meas.n_samples} geometries x {len(meas.channels)} channels), best of "
           f"{REPEAT}, warm\n")
-    print("| run | time (s) |\n|---|---|")
-    for label, call in runs.items():
-        print(f"| {label} | {best(call):.1f} |", flush=True)
+    # the ratio to one coated fit of the same run travels between machines (issue budget:
+    # auto <= 6x coated); the absolute time does not
+    times = {label: best(call) for label, call in runs.items()}
+    coated = times[next(reversed(times))]
+    print("| run | time (s) | ratio to one coated fit |\n|---|---|---|")
+    for label, t in times.items():
+        print(f"| {label} | {t:.2f} | {t / coated:.1f}x |", flush=True)
     print(f"\nload average after: {load()}")
 
 

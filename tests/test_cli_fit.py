@@ -102,7 +102,10 @@ def test_channel_quantity_and_alta_without_param_out(tmp_path):
 
 def test_errors_are_clear(tmp_path):
     res = _fit(DEFAULT, "-m", "tr75", "--loss", "squared", "--out", tmp_path / "x")
-    assert res.exit_code == 2 and "unknown loss 'squared'" in res.output
+    assert res.exit_code == 2, res.output
+    (line,) = res.output.splitlines()  # one line: the option, the value and the choices
+    assert line.startswith("error: --loss: ") and "'squared'" in line
+    assert all(c in line for c in ("auto", "relative", "log", "absolute", "robust")), line
     res = _fit(tmp_path / "missing.astm", "-m", "tr75", "--out", tmp_path / "x")
     assert res.exit_code == 2 and "no such file" in res.output
     res = _fit(DEFAULT, "-m", "no-such-model", "--out", tmp_path / "x")

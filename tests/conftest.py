@@ -2,6 +2,9 @@
 
 * ``shared_data``: the folder ../shared/data (``ROUGHBRDF_SHARED_DATA`` overrides it);
 * ``paints``: the three Mini-Diff paints of :data:`MINIDIFF_PAINTS`, read once per test module.
+
+Hypothesis's profile is loaded here, before any test module is imported
+(tests/hypothesis_profiles.py): derandomized when ``CI`` is set, random otherwise.
 """
 
 from __future__ import annotations
@@ -9,12 +12,16 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import hypothesis_profiles
 import matplotlib
 import pytest
 
 import roughbrdf as rb
 
 matplotlib.use("Agg")  # figures are written to files; no display in CI
+#: "ci" (derandomized: the same draws on every run) when CI is set, "dev" (random) otherwise;
+#: HYPOTHESIS_PROFILE names one and wins
+HYPOTHESIS_PROFILE = hypothesis_profiles.load()
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED_DATA = Path(os.environ.get("ROUGHBRDF_SHARED_DATA", ROOT.parent / "shared" / "data"))

@@ -1,0 +1,82 @@
+"""The suite's Hypothesis profiles (tests/hypothesis_profiles.py): CI draws the same examples on
+every run, a local run draws fresh ones."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import hypothesis_profiles
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+HERE = Path(__file__).resolve()
+#: where :func:`test_draws_recorded` appends its draws; set only by the subprocess runs below
+DRAWS_FILE = "ROUGHBRDF_TEST_DRAWS_FILE"
+
+
+@pytest.mark.parametrize(("environ", "expected"), [
+    ({}, "dev"),
+    ({"CI": ""}, "dev"),
+    ({"CI": "true"}, "ci"),
+    ({"CI": "1"}, "ci"),
+    ({"HYPOTHESIS_PROFILE": "ci"}, "ci"),
+    ({"HYPOTHESIS_PROFILE": "dev", "CI": "true"}, "dev"),
+    ({"HYPOTHESIS_PROFILE": "", "CI": "true"}, "ci"),
+])
+def test_the_environment_selects_the_profile(environ, expected):
+    assert hypothesis_profiles.select(environ) == expected
+
+
+def test_an_unknown_profile_is_refused_by_name():
+    with pytest.raises(ValueError, match="HYPOTHESIS_PROFILE='nightly'"):
+        hypothesis_profiles.select({"HYPOTHESIS_PROFILE": "nightly"})
+
+
+def test_the_ci_profile_is_derandomized_and_the_dev_profile_is_not():
+    ci, dev = settings.get_profile("ci"), settings.get_profile("dev")
+    assert ci.derandomize and ci.database is None and ci.deadline is None and ci.print_blob
+    assert not dev.derandomize and dev.print_blob and dev.database is not None
+
+
+def test_this_run_loaded_the_profile_its_environment_selects():
+    # conftest.py loads it before the test modules are imported; the default settings (the
+    # parent of every @settings(...) of the suite) are the loaded profile's
+    expected = settings.get_profile(hypothesis_profiles.select(os.environ))
+    assert settings.default.derandomize == expected.derandomize
+    assert settings.default.database == expected.database
+
+
+@settings(max_examples=5, deadline=None)  # a test's own settings keep the profile's randomness
+@given(st.integers())
+def test_draws_recorded(x):
+    path = os.environ.get(DRAWS_FILE)
+    if path:
+        with open(path, "a") as f:
+            f.write(f"{x}\n")
+
+
+def _draws(tmp_path: Path, run: int, **env: str) -> list[str]:
+    """The draws of :func:`test_draws_recorded` in a fresh pytest process with ``env`` added to
+    an environment without ``CI`` and ``HYPOTHESIS_PROFILE``."""
+    out = tmp_path / f"draws{run}.txt"
+    base = {k: v for k, v in os.environ.items() if k not in ("CI", "HYPOTHESIS_PROFILE")}
+    proc = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "no:randomly",
+         f"{HERE}::test_draws_recorded"],
+        env={**base, **env, DRAWS_FILE: str(out)}, cwd=tmp_path, capture_output=True,
+        text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    return out.read_text().split()
+
+
+def test_ci_draws_the_same_examples_on_every_run_and_dev_does_not(tmp_path):
+    ci = [_draws(tmp_path, 0, CI="true"), _draws(tmp_path, 1, HYPOTHESIS_PROFILE="ci")]
+    dev = [_draws(tmp_path, 2), _draws(tmp_path, 3)]
+    assert len(ci[0]) == 5 and ci[0] == ci[1]
+    # 5 draws of an integer each from a random seed: two runs agree by chance with a
+    # probability far below 1e-12
+    assert len(dev[0]) == 5 and dev[0] != dev[1]

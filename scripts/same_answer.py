@@ -25,7 +25,8 @@ and compares them with ``host``::
 
 Agreement (the criterion of ``docs/fitting.md``): per candidate, paint and channel,
 ``success`` and the parameters on a bound (and which bound) identical; a parameter at a bound
-within ``1e-6`` relative; any other parameter within ``0.1`` of its standard error; the kept
+within ``1e-6`` relative; any other parameter within ``0.1`` of its standard error (or, in a
+fit held by its energy constraint in both runs, within ``1e-6`` relative); the kept
 candidate (the best by cross-validation) identical. A parameter without a finite standard
 error in both runs and on no bound is one the data do not determine (the width of a lobe
 switched off, TR75's ``e`` when ``n = 1`` turns its lobe off): its value is any, and it is
@@ -77,7 +78,9 @@ for paint in paints:
             out[paint][f"{cand.label}|{c.channel}"] = {
                 "success": bool(c.success), "at_bound": dict(c.at_bound),
                 "params": {k: float(v) for k, v in c.params.items()},
-                "stderr": {k: float(v) for k, v in c.stderr.items()}}
+                "stderr": {k: float(v) for k, v in c.stderr.items()},
+                "constrained": bool(c.energy_constraint is not None
+                                    and c.energy_constraint.active)}
 print(json.dumps(out))
 """
 
@@ -101,12 +104,16 @@ def fits_of(variant: str, data: Path) -> dict:
     return json.loads(run.stdout.strip().splitlines()[-1])
 
 
-def _close(x: float, y: float, sigma: float, bound: bool) -> tuple[bool, str]:
-    """Whether two values of one parameter agree, and the difference in words."""
+def _close(x: float, y: float, sigma: float, bound: bool,
+           constrained: bool = False) -> tuple[bool, str]:
+    """Whether two values of one parameter agree, and the difference in words. On an active
+    energy constraint (a bound on a combination of the parameters, met to its solver's
+    tolerance) either criterion will do: 1e-6 relative, as on a bound, or 0.1 sigma."""
+    rel = abs(x - y) / max(abs(x), abs(y), 1e-300)
     if bound or not (math.isfinite(sigma) and sigma > 0):
-        rel = abs(x - y) / max(abs(x), abs(y), 1e-300)
         return rel <= REL_TOL, f"{rel:.1e} rel"
-    return abs(x - y) <= SIGMA_TOL * sigma, f"{abs(x - y) / sigma:.2g} sigma"
+    ok = abs(x - y) <= SIGMA_TOL * sigma or (constrained and rel <= REL_TOL)
+    return ok, f"{abs(x - y) / sigma:.2g} sigma"
 
 
 def undetermined(a: dict, b: dict, name: str) -> bool:
@@ -137,7 +144,7 @@ def differences(ref: dict, other: dict) -> list[tuple[str, str, str]]:
                 if undetermined(a, b, name):
                     continue
                 ok, how = _close(x, b["params"][name], a["stderr"][name],
-                                 name in a["at_bound"])
+                                 name in a["at_bound"], a["constrained"] and b["constrained"])
                 if not ok:
                     out.append((where, name, how))
     return out

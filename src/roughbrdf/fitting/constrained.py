@@ -38,7 +38,7 @@ import numpy as np
 from ..interrupts import held_interrupts
 from .bounded import LAMBDA_MAX, BoundedResult, GaussNewtonModel
 from .objective import Objective
-from .stationary import GTOL, flat, optimality, scaling, snap
+from .stationary import GTOL, edges_of, flat, optimality, scaling, snap
 
 __all__ = ["BAD_LIMIT", "FEASIBLE", "Limits", "constrained_lm", "finite_limits", "lsi_step",
            "violation"]
@@ -281,7 +281,7 @@ def _settled(obj: Objective, limits: Limits, x: np.ndarray, cost: float, status:
         t = _Trial.at(obj, limits, z)
         return t.cost if violation(t.g) <= allowed and math.isfinite(t.cost) else None
 
-    x, cost, n = snap(x, cost, obj.spec.lower, obj.spec.upper, trial)
+    x, cost, n = snap(x, cost, obj.spec.lower, obj.spec.upper, trial, edges_of(obj.spec))
     return BoundedResult(x, cost, status, message, nfev + n, njev)
 
 

@@ -104,6 +104,14 @@ class JointLayout:
     def upper(self) -> np.ndarray:
         return self._expand(self.spec.upper)
 
+    def snap_edges(self) -> np.ndarray:
+        """:meth:`ObjectiveSpec.snap_edges` of each joint unknown."""
+        per = self.spec.snap_edges()
+        out = np.zeros((len(self.free), 2), dtype=bool)
+        for c in range(len(self.labels)):
+            out[self.index(c)] = per
+        return out
+
     @property
     def n_varys(self) -> int:
         """Joint unknowns, the free data scales (one per channel) included."""

@@ -104,6 +104,38 @@ class ObjectiveSpec:
         """Fitted parameters, the free scale included."""
         return len(self.free) + (1 if self.free_scale else 0)
 
+    def snap_edges(self) -> np.ndarray:
+        """``(p, 2)`` booleans: whether each free parameter's lower and upper bound is an
+        edge of its physical domain (:attr:`Parameter.domain
+        <roughbrdf.models.parameters.Parameter.domain>`, to 1e-9: a lobe's weight 0 or 1,
+        ``k = 0``), as :func:`~roughbrdf.fitting.statistics.limit_kinds` tells them: where
+        :func:`~roughbrdf.fitting.stationary.snap` tries an end from any distance. None with
+        a free scale: a parameter that is one degree of freedom with it (TS67's ``rho_d``) is
+        as good on its edge, but that value would be no result.
+
+        Examples
+        --------
+        >>> import roughbrdf as rb
+        >>> ObjectiveSpec(rb.model("coated", lobes=2), ["n", "w2"], [1.05, 0.0],
+        ...               [2.5, 1.0]).snap_edges().tolist()
+        [[False, False], [True, True]]
+        """
+        by_name = {p.name: p for p in self.model.parameters}
+        out = np.zeros((len(self.free), 2), dtype=bool)
+        if self.free_scale:
+            return out
+        for j, nm in enumerate(self.free):
+            par = by_name.get(nm)
+            if par is None:  # no parameter of that name (none such today): no edge
+                continue
+            lo, lo_in, hi, hi_in = par.domain
+            # an edge the domain includes (an open one, TS67's c > 0, is no value to try)
+            for side, (b, e, inside) in enumerate(((self.lower[j], lo, lo_in),
+                                                   (self.upper[j], hi, hi_in))):
+                out[j, side] = bool(inside and np.isfinite(e)
+                                    and abs(b - e) <= 1e-9 * max(1.0, abs(e)))
+        return out
+
     def start_values(self) -> dict[str, float]:
         """The model's values of the free parameters (where a fit starts)."""
         params = self.model.params

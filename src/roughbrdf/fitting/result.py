@@ -26,7 +26,7 @@ from ..quantity import Quantity
 from .data import input_source
 from .physical import non_physical, physical_range
 from .plausibility import Plausibility, channel_plausibility
-from .statistics import Covariance, GoodnessOfFit, at_bound, limit_kinds
+from .statistics import Covariance, GoodnessOfFit, bound_and_undetermined, limit_kinds
 
 if TYPE_CHECKING:
     from ..measurement import Measurement
@@ -57,13 +57,13 @@ class ChannelFit:
     bounds : dict
         ``name -> (low, high)`` used for the free parameters.
     stderr : dict
-        ``name -> standard error`` (``None`` for fixed parameters, ``nan`` if not estimable or
-        at a bound).
+        ``name -> standard error`` (``None`` for fixed parameters, ``nan`` if not estimable,
+        at a bound or undetermined: without effect at the optimum, named in ``message``).
     at_bound : dict
-        ``name -> "lower" | "upper"`` for the free parameters at a bound
-        (:func:`~roughbrdf.fitting.statistics.at_bound`): no standard error nor correlations
-        (the covariance is not meaningful at an active bound); the others' covariance is
-        computed with them held there. :attr:`limits` tells a physical edge from a search limit.
+        ``name -> "lower" | "upper"`` for the free parameters at a bound, undetermined ones
+        aside (:func:`~roughbrdf.fitting.statistics.bound_and_undetermined`): no standard
+        error nor correlations; the others' covariance is computed with them held there.
+        :attr:`limits` tells a physical edge from a search limit.
     correl : dict
         ``name -> {other: correlation}`` among the free parameters (and ``"scale"``).
     covar : numpy.ndarray
@@ -174,16 +174,16 @@ class ChannelFit:
         r = obj.residual_of(f, k)
         gof = GoodnessOfFit.of(r, data, fitted, scale=k, n_varys=spec.n_varys,
                                floor=obj.floor)
-        bound = at_bound(theta, spec.lower, spec.upper, spec.free)
+        bound, none, jac = bound_and_undetermined(obj, theta, k, r)
         cov = Covariance.at_optimum(obj, theta, f, k, chi2=gof.chi2, dof=gof.dof,
-                                    held=list(bound))
+                                    held=[*bound, *none], jac=jac)
         sd = cov.stderr()
         stderr: dict[str, float | None] = dict.fromkeys(spec.model.param_names)
-        stderr.update({nm: float(s) for nm, s in zip(cov.names, sd, strict=True)
-                       if nm != "scale"})
+        stderr.update({nm: float(s) for nm, s in zip(cov.names, sd, strict=True) if nm != "scale"})
         res = outcome.result
-        message = (res.message.rstrip(".") if res is not None else "no local fit finished")
-        message += cov.note + (f"; at a bound: {', '.join(bound)}" if bound else "")
+        message = (res.message.rstrip(".") if res is not None else "no local fit finished") \
+            + cov.note + (f"; at a bound: {', '.join(bound)}" if bound else "") \
+            + (f"; no effect at the optimum (undetermined): {', '.join(none)}" if none else "")
         return dict(
             channel=obj.data.label, model=fitted_model, params=fitted_model.params,
             free=list(spec.free), init=spec.start_values(),

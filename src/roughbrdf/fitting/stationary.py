@@ -24,16 +24,21 @@ the solvers (:mod:`.bounded`, :mod:`.constrained`) do about each:
   it, so that "at a bound" (:func:`~roughbrdf.fitting.statistics.at_bound`) flips.
   :func:`snap` tries each parameter within :data:`SNAP_DIST` of a bound on the bound and keeps
   it there when the cost rises by at most :data:`SNAP_COST` of itself (a change far below any
-  statistical meaning) and the point stays feasible.
+  statistical meaning) and the point stays feasible. A bound that is an edge of the
+  parameter's physical domain (a lobe's weight 0 or 1, ``k = 0``: ``edges``) is tried from
+  any distance: two lobes of one width are one lobe, and the second one's weight is then any
+  value in its box at one cost (C2_Black's two GGX lobes at 525 nm ended with ``w2 = 0`` in
+  one run and ``w2 = 0.03``, ``alpha2 = alpha`` in another); on the edge, the end is one.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
-__all__ = ["DAMP_FLOOR", "FLAT", "GTOL", "SNAP_COST", "SNAP_DIST", "flat", "optimality",
+__all__ = ["DAMP_FLOOR", "FLAT", "GTOL", "SNAP_COST", "SNAP_DIST", "edges_of", "flat", "optimality",
            "scaling", "snap", "widths"]
 
 #: first-order optimality: the projected gradient's largest cosine with a scaled Jacobian
@@ -137,13 +142,22 @@ def optimality(jac: np.ndarray, f: np.ndarray, x: np.ndarray, lower: np.ndarray,
     return float(np.max(np.abs(grad[keep]) / (np.sqrt(d2[keep]) * norm)))
 
 
+def edges_of(spec: Any) -> np.ndarray | None:
+    """``spec.snap_edges()`` (:meth:`~roughbrdf.fitting.objective.ObjectiveSpec.snap_edges`)
+    where the solver's objective has it, else None (a duck-typed objective with bounds only:
+    ends near a bound alone are tried)."""
+    method = getattr(spec, "snap_edges", None)
+    return None if method is None else np.asarray(method(), dtype=bool)
+
+
 def snap(x: np.ndarray, cost: float, lower: np.ndarray, upper: np.ndarray,
-         trial: Callable[[np.ndarray], float | None]) -> tuple[np.ndarray, float, int]:
+         trial: Callable[[np.ndarray], float | None], edges: np.ndarray | None = None
+         ) -> tuple[np.ndarray, float, int]:
     """Each parameter within :data:`SNAP_DIST` of its box of a bound (and of the bound itself,
-    but for a bound 0), in order, tried on the bound: kept when ``trial(x_new)`` (the cost
-    there, None when the point is refused, e.g. infeasible) is at most
-    ``(1 + SNAP_COST) cost``. Returns the point, its cost and the
-    trials made.
+    but for a bound 0), or at any distance of a bound that ``edges`` (shape ``(p, 2)``: lower,
+    upper) marks as a physical edge, in order, tried on the bound: kept when ``trial(x_new)``
+    (the cost there, None when the point is refused, e.g. infeasible) is at most
+    ``(1 + SNAP_COST) cost``. Returns the point, its cost and the trials made.
 
     Examples
     --------
@@ -152,18 +166,23 @@ def snap(x: np.ndarray, cost: float, lower: np.ndarray, upper: np.ndarray,
     ...                np.zeros(2), np.ones(2), cost)
     >>> x.tolist(), n                              # x0 to its bound 0; x1 is not near one
     ([0.0, 0.499], 1)
+    >>> flat = lambda x: float(1.0 + (x[1] - 0.5) ** 2)  # x0 has no effect: its edge 1 as good
+    >>> snap(np.array([0.3, 0.499]), 1.000001, np.zeros(2), np.ones(2), flat,
+    ...      np.array([[False, True], [False, False]]))[0].tolist()
+    [1.0, 0.499]
     """
     x = np.array(x, dtype=float)
     w = widths(x, lower, upper)
     n = 0
     for j in range(x.size):
-        for b in (lower[j], upper[j]):
+        for side, b in enumerate((lower[j], upper[j])):
             # near: within SNAP_DIST of the box, and of the bound itself unless it is 0 (a
             # bound far below the box's width, 1e-4 of [1e-4, 1], is a search over decades:
-            # 5e-3 is not near it, as for statistics.at_bound)
+            # 5e-3 is not near it, as for statistics.at_bound); a physical edge: from anywhere
             d = abs(x[j] - b)
-            if not np.isfinite(b) or d == 0 or d > SNAP_DIST * w[j] or (
-                    b != 0 and d > SNAP_DIST * abs(b)):
+            edge = edges is not None and bool(edges[j, side])
+            if not np.isfinite(b) or d == 0 or not edge and (d > SNAP_DIST * w[j] or (
+                    b != 0 and d > SNAP_DIST * abs(b))):
                 continue
             x_new = x.copy()
             x_new[j] = b
@@ -172,5 +191,5 @@ def snap(x: np.ndarray, cost: float, lower: np.ndarray, upper: np.ndarray,
             # a cost within SNAP_COST of the end's: the bound is as good (module notes)
             if c is not None and c <= cost + SNAP_COST * abs(cost):
                 x, cost = x_new, c
-            break
+                break  # on a bound: the other side is not tried
     return x, cost, n

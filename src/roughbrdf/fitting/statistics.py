@@ -40,8 +40,8 @@ import numpy as np
 if TYPE_CHECKING:
     from .objective import Objective
 
-__all__ = ["AT_BOUND_RTOL", "Covariance", "GoodnessOfFit", "at_bound", "limit_kinds", "rms_log",
-           "tr75_sigma"]
+__all__ = ["AT_BOUND_RTOL", "Covariance", "GoodnessOfFit", "at_bound", "bound_and_undetermined",
+           "limit_kinds", "rms_log", "tr75_sigma"]
 
 #: a parameter within this fraction of the width of its bounds from a bound is "at the bound"
 AT_BOUND_RTOL = 1e-6
@@ -81,6 +81,29 @@ def at_bound(theta: np.ndarray, lower: np.ndarray, upper: np.ndarray, names: Seq
                 out[nm] = side
                 break
     return out
+
+
+def bound_and_undetermined(obj: Objective, theta: np.ndarray, k: float, r: np.ndarray
+                           ) -> tuple[dict[str, str], list[str], np.ndarray]:
+    """The parameters :func:`at_bound` and those *undetermined* at the optimum ``theta`` of
+    ``obj`` (scale ``k``, residuals ``r``), with the central-difference Jacobian there.
+
+    Undetermined: a parameter without effect at the optimum
+    (:func:`~roughbrdf.fitting.stationary.flat`: a lobe's width at weight 0, TR75's ``e`` when
+    ``n = 1`` turns its lobe off). Where it stopped is any value, so it is not "at a bound"
+    even where it stopped on one (two machines' rounding left it on a bound or not), and it
+    is held in the covariance as the parameters at a bound are: the others keep their
+    standard errors (with it, ``J^T J`` is singular and none would have one).
+    """
+    from .stationary import flat
+
+    spec = obj.spec
+    jac = obj.jac_central(theta, k)
+    none = [nm for nm, fl in zip(spec.free, flat(jac, r, theta, spec.lower, spec.upper),
+                                 strict=True) if fl]
+    bound = {nm: side for nm, side in at_bound(theta, spec.lower, spec.upper,
+                                               spec.free).items() if nm not in none}
+    return bound, none, jac
 
 
 def limit_kinds(at: Mapping[str, str], bounds: Mapping[str, tuple[float, float]],
@@ -236,17 +259,21 @@ class Covariance:
 
     @classmethod
     def at_optimum(cls, obj: Objective, theta: np.ndarray, f: np.ndarray, k: float, *,
-                   chi2: float, dof: int, held: Sequence[str] = ()) -> Covariance:
+                   chi2: float, dof: int, held: Sequence[str] = (),
+                   jac: np.ndarray | None = None) -> Covariance:
         """The sandwich (module notes) from the central-difference Jacobian of ``obj`` at
         ``theta`` (scale held at ``k``), when the scale is free its analytic column at the model
         values ``f``, and the residuals there.
 
         Parameters named in ``held`` (those :func:`at_bound`) are held where they are: they
         get no column, and NaN rows and columns in the result (no standard error, no
-        correlation)."""
+        correlation). ``jac``: that Jacobian (every free parameter's column), when the caller
+        has it already."""
         names = list(obj.spec.free)
         keep = [j for j, nm in enumerate(names) if nm not in held]
-        cols = [obj.jac_central(theta, k, columns=keep)]
+        # C order as jac_central's own (the SVD's last bits follow the memory layout)
+        cols = [obj.jac_central(theta, k, columns=keep) if jac is None
+                else np.ascontiguousarray(jac[:, keep])]
         if obj.spec.free_scale:
             cols.append(obj.scale_column(f, k)[:, None])
             names.append("scale")

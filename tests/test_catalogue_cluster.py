@@ -127,6 +127,60 @@ def test_ctrl_c_at_start_is_one_line_exit_130(data, tmp_path):
     assert not (out / "catalogue.csv").exists()
 
 
+_CTRL_C_DURING_START = textwrap.dedent("""
+    import os, signal, sys, threading
+    from roughbrdf.catalogue import run
+    from roughbrdf.cli import main
+
+    delay = float(os.environ["CTRL_C_DELAY"])
+    start = run.start_local
+
+    def start_local(*args, **kwargs):  # Ctrl-C from the terminal, DELAY s into the start
+        threading.Timer(delay, os.killpg, (os.getpgid(0), signal.SIGINT)).start()
+        return start(*args, **kwargs)
+
+    run.start_local = start_local
+    sys.exit(main(sys.argv[1:]))
+""")
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.4, 1.2, 2.5])
+def test_ctrl_c_during_start_is_one_line_and_stops_the_workers(data, tmp_path, delay):
+    # Ctrl-C reaches the whole process group at any instant of the cluster's start (before
+    # the scheduler, while the workers spawn or import, after they are up): one line, exit
+    # 130, and no process of the group is left (the workers were stopped, not orphaned)
+    out = tmp_path / "cat"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _CTRL_C_DURING_START, "fit-batch", data, "--model", "tr75",
+         "--out", str(out), "--workers", "2", "--starts", "1", "-q"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+        env={**os.environ, "CTRL_C_DELAY": str(delay), "PYTHONWARNINGS": "default"})
+    try:
+        stdout, stderr = proc.communicate(timeout=300)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    lines = stderr.strip().splitlines()
+    # a start that finished before the signal fits and exits 0 (the data are tiny): both
+    # are fine, what is checked is the interrupted case's one line
+    assert proc.returncode in (0, 130), stderr
+    if proc.returncode == 130:
+        assert lines == ["interrupted"], stderr
+        assert not (out / "catalogue.csv").exists()
+    alive = None
+    for _ in range(100):  # the workers' exit follows the client's by a moment
+        try:
+            os.killpg(proc.pid, 0)
+        except ProcessLookupError:
+            alive = False
+            break
+        alive = True
+        import time
+
+        time.sleep(0.1)
+    assert alive is False, "a worker process of the interrupted start is still running"
+
+
 @pytest.mark.parametrize(("options", "message"), [
     (["--starts", "0"], "error: --starts must be >= 1 (got 0)"),
     (["--loss", "x"], "error: --loss: unknown value 'x' (choose from auto, relative, log, "

@@ -37,6 +37,11 @@ removed, a cluster's workers stopped) runs for them too. :func:`interrupt_signal
 one came first (the command line exits with 128 + its number). Outside :func:`watch` only SIGINT
 is handled, as Python does.
 
+The clean-up that follows an interrupt (a cluster's workers stopped, the folders of cancelled
+tasks tidied) runs in :func:`cleaning_up`: signals are held there as in :func:`held_interrupts`,
+but the interrupt already on its way is not raised again by the blocks inside it (each one
+would otherwise end the clean-up at its first step).
+
 Examples
 --------
 >>> with held_interrupts():
@@ -57,7 +62,7 @@ from typing import Any
 
 __all__ = ["held_interrupts", "watch", "interrupted", "raise_if_interrupted",
            "record_interrupts", "late_interrupts", "checkpoint", "set_checkpoint_hook",
-           "interrupt_signal", "ignore_interrupts", "SIGNALS"]
+           "interrupt_signal", "ignore_interrupts", "cleaning_up", "SIGNALS"]
 
 #: the signals that end a program run inside :func:`watch`: Ctrl-C, and the requests to stop
 #: of ``timeout``, a batch system or a service manager (SIGTERM) and of a closed terminal
@@ -73,6 +78,7 @@ _received: list[int] = []  # the first signal that interrupted the current watch
 _hooks: list[Any] = []  # the unraisable hook that watch() replaced
 _late: list[int] = []  # signals recorded after record_interrupts()
 _checkpoint_hook: list[Callable[[str], None]] = []  # test-only (set_checkpoint_hook)
+_cleaning = False  # inside cleaning_up(): an interrupt seen earlier is not raised again
 
 
 def _record(signum: int, frame: Any) -> None:
@@ -121,7 +127,7 @@ def held_interrupts() -> Iterator[None]:
             first = _pending[0]
             _pending.clear()
             _deliver(previous[first], first)
-        elif _seen:
+        elif _seen and not _cleaning:  # a clean-up goes on: its interrupt is on its way
             raise KeyboardInterrupt
 
 
@@ -234,9 +240,38 @@ def interrupt_signal() -> int:
 
 
 def raise_if_interrupted() -> None:
-    """Raise ``KeyboardInterrupt`` if Ctrl-C was pressed inside :func:`watch` (and swallowed)."""
-    if _seen:
+    """Raise ``KeyboardInterrupt`` if Ctrl-C was pressed inside :func:`watch` (and swallowed),
+    unless inside :func:`cleaning_up`."""
+    if _seen and not _cleaning:  # a clean-up goes on: its interrupt is on its way
         raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def cleaning_up() -> Iterator[None]:
+    """Run the clean-up after an interrupt (or an error) to its end.
+
+    Signals are held during the block as by :func:`held_interrupts` (one that comes during it
+    is raised right after it: a second Ctrl-C cannot cut the clean-up short), but an interrupt
+    that came before the block is not raised again inside it, nor at its end: neither by the
+    :func:`held_interrupts` blocks it runs nor by :func:`raise_if_interrupted`. Without that,
+    the first of them re-raises the interrupt recorded by :func:`watch` and the steps after it
+    (the next folder to tidy) never run. The exception the caller is handling goes on as it
+    was.
+
+    Examples
+    --------
+    >>> with watch(), cleaning_up():
+    ...     with held_interrupts():
+    ...         pass
+    """
+    global _cleaning
+    outer = _cleaning
+    _cleaning = True
+    try:
+        with held_interrupts():
+            yield
+    finally:
+        _cleaning = outer
 
 
 def _record_late(signum: int, frame: Any) -> None:

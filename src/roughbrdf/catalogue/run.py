@@ -6,9 +6,12 @@ credentials, no HTTP server, the workers' profiler off), registers
 :class:`~roughbrdf.catalogue.worker.WorkerSetup`, and keeps at most one task per worker thread
 in flight, so that a task's start is known (its per-task time limit counts from there). A task
 whose worker died is run again up to ``retries`` times; a task over the time limit is reported
-failed and its worker restarted. Ctrl-C cancels what is running and closes a cluster this
-module started; the fit folders of finished tasks are complete (each one is committed as a set
-on its worker), and unfinished ones keep no temporary files.
+failed and its worker restarted. Ctrl-C (SIGTERM, SIGHUP: :mod:`roughbrdf.interrupts`)
+cancels what is running and closes a cluster this module started, also one interrupted in the
+middle of its start (its workers are stopped; they never see Ctrl-C themselves:
+:class:`~roughbrdf.catalogue.worker.QuietNanny`); the fit folders of finished tasks are
+complete (each one is committed as a set on its worker), and unfinished ones keep no temporary
+files.
 """
 
 from __future__ import annotations
@@ -24,7 +27,8 @@ from typing import Any
 from .rows import failed_row
 from .tasks import Task, run_task
 
-__all__ = ["run_tasks", "connect", "start_local", "close_local", "STARTED_HOOKS", "CONNECTED_HOOKS"]
+__all__ = ["run_tasks", "connect", "start_local", "close_local", "abandon", "STARTED_HOOKS",
+           "CONNECTED_HOOKS"]
 
 #: seconds between two looks at the running tasks (time limits, progress)
 POLL = 0.2
@@ -77,7 +81,10 @@ def connect(client: Any = None, scheduler: str | None = None,
                 _call(CONNECTED_HOOKS, c)
                 yield c, True
         finally:
-            close_local(cluster)
+            from ..interrupts import cleaning_up
+
+            with cleaning_up():  # a second Ctrl-C must not leave the workers running
+                close_local(cluster)
     finally:
         _restore_environ(saved)
 
@@ -123,10 +130,13 @@ def start_local(n: int, spawn: dict[str, str]) -> Any:
     * no HTTP server (:class:`~roughbrdf.catalogue.worker.QuietScheduler`), so no port 8787
       and no warning when it is taken;
     * the workers' statistical profiler off (its call stacks grow the workers' memory);
-    * SIGINT ignored in the worker processes as soon as they load their worker class
-      (:data:`~roughbrdf.catalogue.worker.WORKER_ENV` marks them): Ctrl-C in a terminal
+    * SIGINT blocked in the worker processes from their start
+      (:class:`~roughbrdf.catalogue.worker.QuietNanny`) and ignored once they load their worker
+      class (:data:`~roughbrdf.catalogue.worker.WORKER_ENV` marks them): Ctrl-C in a terminal
       reaches the whole process group, and a worker would print its traceback; the client
-      cancels the tasks and closes the cluster instead.
+      cancels the tasks and closes the cluster instead;
+    * a start interrupted (Ctrl-C, SIGTERM) or failed half-way stops what was started (the
+      scheduler, the workers up or starting: :func:`abandon`) before the exception goes on.
     """
     import logging
 
@@ -141,17 +151,71 @@ def start_local(n: int, spawn: dict[str, str]) -> Any:
     common = {"host": "127.0.0.1", "protocol": "tls://", "security": security}
     scheduler = {"cls": QuietScheduler,
                  "options": {**common, "port": 0, "dashboard": False, "dashboard_address": None}}
+    nannies: list[Any] = []  # every nanny made, up or not (QuietNanny's owner)
     worker = {"cls": QuietNanny,
               "options": {**common, "nthreads": 1, "env": WORKER_ENV, "dashboard": False,
+                          "owner": nannies,
                           "memory_limit": parse_memory_limit(
                               "auto", 1, n, logger=logging.getLogger("distributed")),
                           "silence_logs": logging.ERROR}}
     config = {"distributed.nanny.pre-spawn-environ": spawn,
               "distributed.worker.profile.enabled": False,
               "logging.distributed": "error"}  # the workers' own log lines are not the user's
+    # made in two steps, so that a start interrupted inside SpecCluster's __init__ (nearly all
+    # of the start happens there) leaves an object to stop
+    cluster = SpecCluster.__new__(SpecCluster)
     with dask.config.set(config):
-        return SpecCluster(scheduler=scheduler, workers={i: worker for i in range(n)},
-                           worker=worker, security=security, silence_logs=logging.ERROR)
+        try:
+            SpecCluster.__init__(cluster, scheduler=scheduler,
+                                 workers={i: worker for i in range(n)}, worker=worker,
+                                 security=security, silence_logs=logging.ERROR)
+        except BaseException:
+            from ..interrupts import cleaning_up
+
+            with cleaning_up():  # a second Ctrl-C must not leave the workers running
+                abandon(cluster, nannies)
+            raise
+    return cluster
+
+
+def abandon(cluster: Any, nannies: list[Any], timeout: float = CLOSE_TIMEOUT) -> None:
+    """Stop a local cluster whose start was interrupted: its scheduler and every nanny made
+    (``nannies``), each worker process once it is up; those still alive after ``timeout``
+    seconds are killed.
+
+    ``SpecCluster.close()`` alone cannot: the start it was in is cancelled, the workers still
+    starting are not yet the cluster's (it would close none, and fail on them), a cluster
+    whose own start was cancelled stays "starting" (its close would skip the scheduler), and
+    the worker processes would live on until this one exits. distributed's warnings stay
+    silenced meanwhile (a connection cut in its TLS handshake is one).
+    """
+    import asyncio
+    import logging
+    import signal
+
+    from distributed.core import Status
+    from distributed.utils import silence_logging_cmgr
+
+    async def stop() -> None:
+        await asyncio.sleep(0.05)  # the start's cancellation (queued before this) goes first
+        # a nanny can only stop its worker once that one is up: let the starts end first
+        await asyncio.gather(*nannies, return_exceptions=True)
+        await asyncio.gather(*(nanny.close(timeout=timeout / 2) for nanny in nannies),
+                             return_exceptions=True)
+        # a start cancelled half-way leaves "starting": as "failed", close stops everything
+        if getattr(cluster, "status", None) == Status.starting:
+            cluster.status = Status.failed
+
+    with silence_logging_cmgr(logging.ERROR):
+        try:
+            cluster.sync(stop, callback_timeout=timeout)
+            cluster.close(timeout=timeout)
+        except Exception:  # a timeout, or a start interrupted before its loop ran: kill below
+            with contextlib.suppress(Exception):  # no loop to stop (never started)
+                cluster._loop_runner.stop()
+    for pid in {pid for pid in map(_worker_pid, nannies) if pid}:
+        with contextlib.suppress(OSError):  # already gone (the usual case)
+            os.kill(pid, signal.SIGKILL)
 
 
 def _call(hooks: list[Callable[[Any], None]], arg: Any) -> None:
@@ -279,15 +343,20 @@ class _Loop:
         self.running.clear()
 
     def close(self) -> None:
+        from ..interrupts import cleaning_up
+
         if self.bar is not None:
             self.bar.close()
-        if self.local:
-            for task in self.unfinished:
-                tidy(task.folder)
-        # the workers restarted or dead under a task: their locks and temporary files (a
-        # live process's are never touched: tidy judges each by its process id)
-        for folder in dict.fromkeys(self.killed):
-            tidy(folder)
+        # every folder, also after Ctrl-C or SIGTERM (the interrupt would otherwise be raised
+        # again by the first tidy's first held block, and end the others)
+        with cleaning_up():
+            if self.local:  # the tasks of a cluster of ours are cancelled, its workers gone
+                for task in self.unfinished:
+                    tidy(task.folder)
+            # the workers restarted or dead under a task: their locks and temporary files (a
+            # live process's are never touched: tidy judges each by its process id)
+            for folder in dict.fromkeys(self.killed):
+                tidy(folder)
 
 
 def _workers_of(client: Any, futures: list[Any]) -> set[str]:

@@ -65,11 +65,51 @@ class QuietWorker(Worker):
 
 
 class QuietNanny(Nanny):
-    """A nanny whose worker process is a :class:`QuietWorker`."""
+    """A nanny whose worker process is a :class:`QuietWorker`, and never sees Ctrl-C.
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
+    SIGINT, SIGTERM and SIGHUP (:data:`roughbrdf.interrupts.SIGNALS`) are blocked in the
+    thread that makes the nanny (the cluster's event loop), and so in the threads it starts,
+    which spawn the worker processes: a process inherits the signal mask of the thread that
+    forks it and keeps it across ``exec``, so a worker process starts with them blocked, from
+    its first instruction on. Without that, a Ctrl-C during the cluster's start-up (it reaches
+    the whole process group) interrupts the workers while they import and each prints its
+    traceback; a SIGTERM to the group (systemd, SLURM) kills them under their nannies, which
+    log the failures. The client stops the workers instead (distributed stops a worker by a
+    message, then SIGKILL; a worker whose client process is gone exits by itself). ``owner``
+    (a list) receives the nanny once made.
+    """
+
+    def __init__(self, *args: Any, owner: list[Any] | None = None, **kwargs: Any) -> None:
         kwargs["worker_class"] = QuietWorker
+        _block_signals_in_this_thread()
         super().__init__(*args, **kwargs)
+        if owner is not None:  # the list of start_local's cluster: stopped if its start fails
+            owner.append(self)
+
+
+def _block_signals_in_this_thread() -> None:
+    """Block :data:`roughbrdf.interrupts.SIGNALS` in the calling thread (and the threads and
+    processes it starts), unless it is the main thread (there Python handles Ctrl-C: the
+    program must stay interruptible)."""
+    import signal
+    import threading
+
+    # the main thread (an asynchronous cluster on the caller's loop) keeps its Ctrl-C; a
+    # platform without pthread_sigmask (Windows) has no process groups to send it to workers
+    if threading.current_thread() is threading.main_thread() or not hasattr(
+            signal, "pthread_sigmask"):
+        return
+    from multiprocessing import resource_tracker
+
+    from ..interrupts import SIGNALS
+
+    # multiprocessing starts its resource tracker when the nanny makes its first queue, and
+    # then *unblocks* SIGINT and SIGTERM in the thread that started it: start it here, with
+    # SIGHUP blocked too (it ignores the other two; a terminal's SIGHUP would kill it, and its
+    # successor print a traceback per queue), then block again
+    signal.pthread_sigmask(signal.SIG_BLOCK, set(SIGNALS))
+    resource_tracker.ensure_running()
+    signal.pthread_sigmask(signal.SIG_BLOCK, set(SIGNALS))
 
 
 def warm(model: Any) -> None:

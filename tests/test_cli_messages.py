@@ -277,3 +277,28 @@ def test_fit_json_file_that_is_not_a_file(capsys, tmp_path, fit_json, where):
     code, err = _run(capsys, "plot", "--fit", d, "--out", tmp_path / "p.png")
     line = _one_line(err)
     assert code == 2 and "fit.json" in line and repr(c["file"]) in line
+
+
+@pytest.mark.parametrize(("args", "start"), [
+    # what the parser refuses before a verb runs: an option's value of the wrong type, an
+    # unknown option, a missing argument or option (Typer's own messages, made one line)
+    (["fit", DEFAULT, "--starts", "x"], "error: --starts: invalid value 'x': "),
+    (["fit-batch", DEFAULT, "--workers", "y", "--out", "o"], "error: --workers: invalid value 'y'"),
+    (["fit", DEFAULT, "--nosuch"], "error: --nosuch: no such option"),
+    (["fit"], "error: FILE: missing (a required argument)"),
+    (["compare", DEFAULT, "--seed", "-1"], "error: --seed"),
+    (["fit", DEFAULT, "--model", "tr75", "--out", "o", "--fix", "e=0.5"],
+     "error: --fix e=0.5: a parameter name is expected"),
+    (["fit", DEFAULT, "--model", "tr75", "--out", "o", "--fix", "zz"], "error: --fix"),
+    (["fit", DEFAULT, "--model", "tr75", "--out", "o", "--angles-in", "grad"],
+     "error: --angles-in: unknown angle unit 'grad'"),
+])
+def test_parser_errors_are_one_line_naming_the_option(capsys, tmp_path, monkeypatch, args,
+                                                      start):
+    monkeypatch.chdir(tmp_path)  # nothing is written; a relative --out would land here
+    code, err = _run(capsys, *args)
+    assert code == 2, err
+    line = _one_line(err)
+    assert line.startswith(start), line
+    assert "Usage:" not in err and "╭" not in err  # no usage block, no framed panel
+    assert not any(tmp_path.iterdir())

@@ -98,7 +98,9 @@ def build_app() -> typer.Typer:
 
     import typer
 
-    new = typer.Typer(add_completion=False, no_args_is_help=True,
+    from .usage import OneLineGroup  # the parser's own errors as one line each
+
+    new = typer.Typer(add_completion=False, no_args_is_help=True, cls=OneLineGroup,
                       help="roughbrdf: rough-surface BRDF models - evaluate, fit (a file or "
                            "a catalogue), compare, export, plot, convert, reproduce.")
 

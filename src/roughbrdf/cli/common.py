@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from . import EXIT_BUG, EXIT_OS, EXIT_USAGE, Run, interrupt_line, interrupted_status
+from .options import OptionError, naming
 
 if TYPE_CHECKING:
     import numpy as np
@@ -170,17 +171,40 @@ def error_message(exc: BaseException, options: Mapping[str, str] | None = None,
     if isinstance(exc, OverwriteRefused):
         return exc.render(opts)
     if isinstance(exc, OSError) and exc.strerror:
-        where = exc.filename
+        where = None if exc.filename is None else shown_name(exc.filename)
         if exc.filename2 is not None:
-            where = f"{exc.filename} -> {exc.filename2}"
+            where = f"{where} -> {shown_name(exc.filename2)}"
         return f"{where}: {exc.strerror}" if where is not None else exc.strerror
     if isinstance(exc, MemoryError):
         return f"out of memory{': ' + str(exc) if str(exc) else ''}"
     text = " ".join(str(exc).split()) or type(exc).__name__
+    if not text.isprintable():  # a control character (an escape) left: shown escaped
+        from ..catalogue.rows import one_line
+
+        text = one_line(text)
     if (exit_status(exc) if code is None else code) == EXIT_BUG:
         return (f"internal error: {type(exc).__name__}: {text} (a bug in roughbrdf; "
                 f"`roughbrdf --debug ...` shows the traceback)")
     return cli_text(text, opts)
+
+
+def shown_name(name: object) -> str:
+    r"""A file name as one-line messages show it (:func:`roughbrdf.catalogue.rows.shown_name`:
+    as it is, or quoted like a Python string when it holds a newline, a tab or another
+    character that is not printable); the catalogue, which imports the models, is loaded
+    only for such a name.
+
+    Examples
+    --------
+    >>> print(shown_name("a b.csv"), shown_name("two\nlines.csv"))
+    a b.csv 'two\nlines.csv'
+    """
+    text = str(name)
+    if text.isprintable():  # the common case, without importing the catalogue
+        return text
+    from ..catalogue.rows import shown_name as quoted
+
+    return quoted(text)
 
 
 def argument_text(exc: ArgumentError, options: Mapping[str, str]) -> str:
@@ -331,21 +355,35 @@ def angle_names(model: Model) -> set[str]:
     return {p.name for p in model.parameters if p.unit == ANGLE_UNIT}
 
 
-def cli_model(spec: str, params: Mapping[str, object] | None = None) -> Model:
+def cli_model(spec: str, params: Mapping[str, object] | None = None,
+              option: str | None = None) -> Model:
     """``roughbrdf.model(spec, **params)`` with ``-p`` settings as the CLI gives them: a
     parameter whose unit is an angle (Oren-Nayar ``sigma``, also in ``coated(diffuse=
     "oren-nayar")`` and in sums, by plain or prefixed name) in degrees.
+
+    With ``option`` (how the verb takes the spec: ``"--model"``, ``"MODEL"``) an error names
+    what is wrong: the spec (``option``) or a ``-p`` setting (``-p/--param``)
+    (:class:`~roughbrdf.cli.options.OptionError`); without it the library's error passes.
 
     Examples
     --------
     >>> round(cli_model("oren-nayar", {"sigma": 20.0}).params["sigma"], 6)
     0.349066
+    >>> cli_model("lambertian", {"rho": "x"}, "MODEL")
+    Traceback (most recent call last):
+    ...
+    roughbrdf.cli.options.OptionError: -p/--param: rho = 'x': parameter 'rho' must be a number
     """
     from .. import models as _models
 
     given = dict(params or {})
-    first = _models.model(spec, **given)  # names and units (angles in degrees pass the
-    angles = angle_names(first)  # sign checks of their domains just as well)
+    try:
+        first = _models.model(spec, **given)  # names and units (angles in degrees pass the
+    except ValueError as exc:  # sign checks of their domains just as well)
+        if option is None:
+            raise
+        raise _model_error(spec, option, exc, bool(given)) from exc
+    angles = angle_names(first)
     if not angles:
         return first
     converted = dict(given)
@@ -358,7 +396,25 @@ def cli_model(spec: str, params: Mapping[str, object] | None = None) -> Model:
             continue
         if name in angles:
             converted[key] = math.radians(value)
-    return _models.model(spec, **converted)
+    if option is None:
+        return _models.model(spec, **converted)
+    with naming("-p/--param"):  # an angle's value outside its domain
+        return _models.model(spec, **converted)
+
+
+def _model_error(spec: str, option: str, exc: ValueError, settings: bool) -> OptionError:
+    """The error of a model that could not be made: of the spec (``option``) when the spec
+    alone fails too, else of the ``-p`` settings."""
+    from .. import models as _models
+
+    if settings:
+        try:
+            _models.model(spec)
+        except ValueError:  # the spec itself is wrong
+            pass
+        else:
+            return OptionError("-p/--param", str(exc))
+    return OptionError(option, str(exc))
 
 
 def cli_parameter_lines(model: Model) -> list[str]:

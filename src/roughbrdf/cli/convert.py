@@ -15,7 +15,8 @@ from typing import Annotated, Any
 
 import typer
 
-from .common import CONVERT_OPTIONS, cli_text
+from .common import CONVERT_OPTIONS, cli_text, shown_name
+from .options import OptionError, check_format
 
 #: the quantities a measurement can hold, for the help text (the same as
 #: :data:`roughbrdf.measurement.QUANTITIES`, written out so that ``--help`` imports no NumPy/Numba;
@@ -53,8 +54,8 @@ def _os_message(exc: OSError, src: Path, dst: Path) -> str:
     if exc.strerror is None:  # raised with a message of its own (a folder given as OUT)
         return str(exc)
     if exc.filename is not None and Path(str(exc.filename)).absolute() == src.absolute():
-        return f"cannot read {src}: {exc.strerror}"
-    return f"cannot write {dst}: {exc.strerror}"
+        return f"cannot read {shown_name(src)}: {exc.strerror}"
+    return f"cannot write {shown_name(dst)}: {exc.strerror}"
 
 
 def _echo_warnings(caught: list[warnings.WarningMessage]) -> None:
@@ -100,7 +101,7 @@ def _check_paths(src: Path, dst: Path, force: bool) -> None:
     from ..output import same_file
 
     if not src.exists():
-        raise FileNotFoundError(f"{src}: no such file")
+        raise FileNotFoundError(f"{shown_name(src)}: no such file")
     if src.is_dir():  # not a file of an unknown extension
         raise ValueError(f"IN {src} is a folder; convert reads one measurement file")
     if same_file(src, dst) or src.resolve() == dst.resolve():
@@ -129,12 +130,29 @@ def _report(m: Any, dst: Path, fout: str, result: Any) -> None:
                    f"below the horizon, {m.meta.get('merl_invalid', 0)} marked invalid (-1)")
 
 
+def _checked(args: dict[str, Any]) -> dict[str, Any]:
+    """The options' values checked, before any file is looked at (each error names its option
+    and the value), in the spellings the readers and writers take."""
+    from ..quantity import Quantity
+    from .fit import angle_unit
+
+    check_format(args["from_"], "--from", "format")
+    check_format(args["to"], "--to", "format")
+    out = dict(args)
+    for key, option in (("quantity", "--quantity"), ("as_quantity", "--as")):
+        if args[key] is not None:  # the same spellings as every other verb's --quantity
+            out[key] = Quantity.parse(args[key], option).value
+    for key, option in (("angles_in", "--angles-in"), ("angles_out", "--angles-out")):
+        out[key] = angle_unit(args[key], option)
+    if args["stride"] is not None and args["stride"] < 1:
+        raise OptionError("--stride", f"must be >= 1 (got {args['stride']})")
+    return out
+
+
 def _convert(src: Path, dst: Path, args: dict[str, Any]) -> None:
     from .. import io as _io
-    from ..quantity import Quantity
 
-    if args["quantity"] is not None:  # the same spellings as every other verb's --quantity
-        args = {**args, "quantity": Quantity.parse(args["quantity"], "--quantity").value}
+    args = _checked(args)
     _check_paths(src, dst, args["force"])
     fin = _io.format_for(src, args["from_"])
     fout = _io.format_for(dst, args["to"])

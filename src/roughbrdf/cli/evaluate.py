@@ -110,7 +110,7 @@ def _evaluate(model: str, params: dict, theta_i: str, theta_r: str, phi: str,
 
     from ..quantity import Quantity
 
-    m = cli_model(model, params)  # -p angles (Oren-Nayar sigma) in degrees
+    m = cli_model(model, params, "MODEL")  # -p angles (Oren-Nayar sigma) in degrees
     ti = degree_range(theta_i, "--theta-i")
     tr = degree_range(theta_r, "--theta-r")
     ph = degree_range(phi, "--phi")

@@ -24,6 +24,7 @@ from typing import Annotated, Any
 import typer
 
 from .common import EXPORT_OPTIONS, cli_model, degree_range, handled, parse_params
+from .options import pick_channel
 
 #: the library's argument names -> this verb's options (errors name the options)
 OPTIONS = {**EXPORT_OPTIONS, "allow_energy_gain": "--allow-energy-gain"}
@@ -58,7 +59,7 @@ def _source(model: str | None, param: list[str] | None, fit_dir: str | None,
                                      "exports to --to zemax-abg (its rows)")
                 return doc
         return fitted_models(fit_dir)
-    return cli_model(str(model), parse_params(param))  # -p angles (sigma) in degrees
+    return cli_model(str(model), parse_params(param), "MODEL")  # -p angles in degrees
 
 
 def _zemax_options(incidences: str | None, radial: str | None, azimuth: str | None,
@@ -110,9 +111,9 @@ def run_export(model: str | None, param: list[str] | None, fit_dir: str | None, 
             options["theta_max"] = math.radians(theta_max)
     source = _source(model, param, fit_dir, target)
     chan: Any = channel
-    if channel is not None and channel.lstrip("-").isdigit() and isinstance(source, dict) \
-            and channel not in source:
-        chan = int(channel)
+    if channel is not None and isinstance(source, dict) and not source.get("per_incidence"):
+        labels = list(source)  # a fit's {channel: model}: a label or an index, checked here
+        chan = labels[pick_channel([str(k) for k in labels], channel)]
     res = export(source, Path(out), to=target, overwrite=force, channel=chan,
                  allow_energy_gain=allow_energy_gain, **options)
     typer.echo(res.report)

@@ -48,7 +48,17 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from .common import FIT_OPTIONS, angle_names, check_channels, cli_model, handled, parse_params
-from .options import ModelInput, ReadInput, channel_labels, command, fit_options
+from .options import (
+    ModelInput,
+    OptionError,
+    ReadInput,
+    channel_labels,
+    check_format,
+    command,
+    fit_options,
+    naming,
+    unknown_value,
+)
 
 if TYPE_CHECKING:
     from ..fitting.options import FitOptions
@@ -67,8 +77,8 @@ ANGLE_UNITS = {"deg": "deg", "degree": "deg", "degrees": "deg", "rad": "rad", "r
 def build_model(spec: str, params: dict[str, Any] | None = None) -> Model:
     """A model from ``name`` or ``name1+name2`` and ``-p`` settings (:func:`roughbrdf.model`);
     a parameter whose unit is an angle (Oren-Nayar ``sigma``) is given in degrees
-    (:func:`~roughbrdf.cli.common.cli_model`)."""
-    return cli_model(spec, params)
+    (:func:`~roughbrdf.cli.common.cli_model`); an error names ``--model`` or ``-p/--param``."""
+    return cli_model(spec, params, "--model")
 
 
 def resolve_names(model: Model, names: list[str]) -> list[str]:
@@ -76,6 +86,26 @@ def resolve_names(model: Model, names: list[str]) -> list[str]:
     from .. import models as _models
 
     return _models.resolve_names(model, names)
+
+
+def fixed_names(model: Model, names: list[str]) -> list[str]:
+    """``--fix NAME`` (repeatable) -> the model's parameter names; an unknown name, or a
+    ``NAME=VALUE`` (the value is set with ``-p``), is refused naming ``--fix``.
+
+    Examples
+    --------
+    >>> import roughbrdf as rb
+    >>> fixed_names(rb.model("lambertian"), ["rho=0.2"])
+    Traceback (most recent call last):
+    ...
+    roughbrdf.cli.options.OptionError: --fix rho=0.2: a parameter name is expected ...
+    """
+    for name in names:
+        if "=" in name:
+            raise OptionError("--fix", f"--fix {name}: a parameter name is expected (its value "
+                                       f"is set with -p {name})")
+    with naming("--fix"):
+        return resolve_names(model, names)
 
 
 def parse_bounds(model: Model, items: list[str] | None) -> dict[str, tuple[float, float]]:
@@ -103,7 +133,8 @@ def parse_bounds(model: Model, items: list[str] | None) -> dict[str, tuple[float
                              f"{item!r}") from None
         if not (math.isfinite(low) and math.isfinite(high) and low < high):
             raise ValueError(f"--bounds {item}: need finite LOW < HIGH")
-        (key,) = resolve_names(model, [name.strip()])
+        with naming("--bounds"):
+            (key,) = resolve_names(model, [name.strip()])
         out[key] = (low, high)
         if key in angle_names(model):
             out[key] = (math.radians(low), math.radians(high))
@@ -147,13 +178,24 @@ def start_within(model: Model, ranges: dict[str, tuple[float, float]],
     return model.with_values(list(move), list(move.values())) if move else model
 
 
-def angle_unit(text: str | None) -> str | None:
-    """``--angles-in`` -> the readers' ``angles=`` value (``"deg"``/``"rad"``), or None."""
+def angle_unit(text: str | None, option: str = "--angles-in") -> str | None:
+    """``--angles-in`` (or ``--angles-out``: ``option``) -> the readers' ``angles=`` value
+    (``"deg"``/``"rad"``), or None.
+
+    Examples
+    --------
+    >>> angle_unit("Degrees"), angle_unit(None)
+    ('deg', None)
+    >>> angle_unit("grad")
+    Traceback (most recent call last):
+    ...
+    roughbrdf.cli.options.OptionError: --angles-in: unknown angle unit 'grad' (choose from ...)
+    """
     if text is None:
         return None
     unit = ANGLE_UNITS.get(text.strip().lower())
     if unit is None:
-        raise ValueError(f"--angles-in must be deg or rad, got {text!r}")
+        raise unknown_value(option, text, ["deg", "rad"], what="angle unit")
     return unit
 
 
@@ -169,6 +211,7 @@ def read_input(file: str, file_format: str | None, quantity: str | None,
     if Path(file).is_dir():  # not a file of an unknown extension: a verb for one file
         raise ValueError(f"{file} is a folder: this command reads one measurement file "
                          f"(fit-batch fits the files of a folder)")
+    check_format(file_format)  # the option named, not the file
     opts: dict[str, Any] = {}
     if quantity:
         opts["quantity"] = Quantity.parse(quantity, "--quantity").value
@@ -227,7 +270,7 @@ def resolve_model(given: ModelInput, options: FitOptions) -> tuple[Model | str, 
         return "auto", options
     params = parse_params(given.param)
     m = build_model(given.spec, params)
-    fixed = resolve_names(m, list(given.fix or []))
+    fixed = fixed_names(m, list(given.fix or []))
     ranges = parse_bounds(m, given.bounds)
     return start_within(m, ranges, params), options.replace(fix=fixed, bounds=ranges or None)
 

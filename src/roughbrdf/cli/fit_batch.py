@@ -27,7 +27,7 @@ import typer
 
 from .common import handled
 from .fit import OPTIONS, resolve_model
-from .options import ModelInput, check_search, command, fit_options
+from .options import ModelInput, check_format, check_search, command, fit_options
 
 if TYPE_CHECKING:
     from ..fitting.options import FitOptions
@@ -56,13 +56,7 @@ def read_options(quantity: str | None, angles_in: str | None,
     if unit is not None:
         opts["angles"] = unit
     if file_format:
-        from ..io import FORMATS, format_for
-
-        try:  # every worker would refuse the files otherwise, one failure each
-            format_for("input", file_format)
-        except ValueError:
-            raise ValueError(f"--format: unknown value {file_format!r} (choose from "
-                             f"{', '.join(FORMATS)})") from None
+        check_format(file_format)  # every worker would refuse the files, one failure each
         opts["format"] = file_format
     return opts
 

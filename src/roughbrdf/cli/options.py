@@ -8,13 +8,20 @@ into radians and checked in CLI terms), a :class:`ModelInput` (``--model``, ``-p
 ``--bounds``, ``--models``; resolved on the model by
 :func:`roughbrdf.cli.fit.resolve_model`) and a :class:`ReadInput` (``--quantity``, ``--angles-in``,
 ``--format``). Nothing heavy is imported at module level (``roughbrdf --help`` stays fast).
+
+Every error about an option's value is an :class:`OptionError`, one line that starts with the
+option (``--loss: unknown value 'x' (choose from ...)``): :func:`unknown_value` words a value
+not among the choices, :func:`naming` puts the option ahead of a library error raised while a
+value is used, and :func:`pick_channel` resolves a ``--channel`` of a saved fit. Every verb uses
+these (exit status 2, :data:`roughbrdf.cli.EXIT_USAGE`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import inspect
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -23,8 +30,9 @@ import typer
 if TYPE_CHECKING:
     from ..fitting.options import FitOptions
 
-__all__ = ["TABLE", "ModelInput", "ReadInput", "channel_labels", "check_aperture",
-           "check_search", "command", "fit_domain", "fit_options"]
+__all__ = ["TABLE", "ModelInput", "OptionError", "ReadInput", "channel_labels",
+           "check_aperture", "check_format", "check_search", "command", "fit_domain",
+           "fit_options", "naming", "pick_channel", "unknown_value"]
 
 # the options of model choice, joint fits and the fit domain, shared with `roughbrdf compare`
 ModelsOption = Annotated[str | None, typer.Option(
@@ -121,6 +129,110 @@ _AS_GIVEN = ("loss", "starts", "seed", "nonfinite", "negative", "relative_to", "
 _FITTING = ("energy_constraint", "wavelength")
 
 
+class OptionError(ValueError):
+    """A bad value of a command-line option: one line that starts with the option.
+
+    Parameters
+    ----------
+    option : str
+        The option as the command line spells it (``"--loss"``, ``"-p/--param"``, or an
+        argument's metavar such as ``"MODEL"``).
+    message : str
+        What is wrong, naming the offending value; white space is made one line, and the
+        option is put ahead unless the message starts with it already.
+
+    Examples
+    --------
+    >>> str(OptionError("--fix", "unknown parameter 'zz'"))
+    "--fix: unknown parameter 'zz'"
+    >>> str(OptionError("--starts", "--starts must be >= 1 (got 0)"))
+    '--starts must be >= 1 (got 0)'
+    """
+
+    def __init__(self, option: str, message: str) -> None:
+        self.option = option
+        text = " ".join(str(message).split())
+        if not (text.startswith(option) and text[len(option):len(option) + 1] in ("", " ", ":")):
+            text = f"{option}: {text}"
+        super().__init__(text)
+
+
+def unknown_value(option: str, value: object, choices: Sequence[str],
+                  what: str = "value") -> OptionError:
+    """The error of a value of ``option`` that is none of ``choices`` (to raise).
+
+    Examples
+    --------
+    >>> str(unknown_value("--paper", "x", ["ts67", "tr75", "rb08", "all"]))
+    "--paper: unknown value 'x' (choose from ts67, tr75, rb08, all)"
+    >>> str(unknown_value("--to", "hdf5", ["astm", "csv"], what="format"))
+    "--to: unknown format 'hdf5' (choose from astm, csv)"
+    """
+    return OptionError(option, f"unknown {what} {value!r} (choose from {', '.join(choices)})")
+
+
+@contextlib.contextmanager
+def naming(option: str) -> Iterator[None]:
+    """A ``ValueError`` raised inside (the library checking a value of ``option``) becomes an
+    :class:`OptionError` of ``option``: its message, put after the option. An
+    :class:`OptionError` (of any option) passes as it is; other errors (files, bugs) too.
+
+    Examples
+    --------
+    >>> with naming("--model"):
+    ...     raise ValueError("unknown model 'x'")
+    Traceback (most recent call last):
+    ...
+    roughbrdf.cli.options.OptionError: --model: unknown model 'x'
+    """
+    try:
+        yield
+    except OptionError:
+        raise
+    except ValueError as exc:
+        raise OptionError(option, str(exc)) from exc
+
+
+def check_format(file_format: str | None, option: str = "--format", what: str = "value"
+                 ) -> None:
+    """Refuse a format name (``--format``, ``--from``, ``--to``) the readers do not know,
+    before any file is read: the option, the value (``what``: ``"value"``, or ``"format"``
+    where the option's name does not say it is one) and the formats there are."""
+    if file_format is None:
+        return
+    from ..io import FORMATS, format_for
+
+    try:
+        format_for("input", file_format)
+    except ValueError:
+        raise unknown_value(option, file_format, list(FORMATS), what) from None
+
+
+def pick_channel(labels: Sequence[str], channel: str) -> int:
+    """The position of ``--channel`` (a label, a label without its ``nm``, or an index, as
+    :meth:`roughbrdf.Measurement.channel_index` takes them) among the channels of a saved fit.
+
+    Examples
+    --------
+    >>> pick_channel(["465nm", "525nm"], "525"), pick_channel(["465nm", "525nm"], "-1")
+    (1, 1)
+    >>> pick_channel(["relative"], "9")
+    Traceback (most recent call last):
+    ...
+    roughbrdf.cli.options.OptionError: --channel: unknown channel '9' (the fit has 1 channel: ...)
+    """
+    names = [str(c) for c in labels]
+    for form in (names, [n.removesuffix("nm") for n in names]):
+        if form.count(channel) == 1:
+            return form.index(channel)
+    if channel.lstrip("-").isdigit() and -len(names) <= int(channel) < len(names):
+        return int(channel) % len(names)
+    count = f"{len(names)} channel{'s' if len(names) != 1 else ''}"
+    raise OptionError("--channel", f"unknown channel {channel!r} (the fit has {count}: "
+                                   f"{', '.join(names)}; a label or an index from 0 to "
+                                   f"{len(names) - 1})")
+
+
 def command(func: Callable[..., Any], order: list[str],
             own: Mapping[str, tuple[Any, Any]]) -> Callable[..., Any]:
     """``func`` (a verb taking ``**values``) with the signature typer reads: the parameters
@@ -173,16 +285,14 @@ def check_search(starts: int | None, loss: str | None, seed: int | None,
         if loss is not None and loss != "auto":
             Loss.parse(loss)
     except ValueError:
-        raise ValueError(f"--loss: unknown value {loss!r} (choose from auto, "
-                         f"{', '.join(LOSSES)})") from None
+        raise unknown_value("--loss", loss, ["auto", *LOSSES]) from None
     if seed is not None and seed < 0:  # numpy's generators take no negative seed
         raise ValueError(f"--seed must be >= 0 (got {seed})")
     if relative_to is not None:
         try:  # what a relative file's values are proportional to (fitting.data.Comparison)
             Quantity.RELATIVE.compared_with(relative_to)
         except ValueError:
-            raise ValueError(f"--relative-to: unknown value {relative_to!r} (choose from brdf, "
-                             f"bridf)") from None
+            raise unknown_value("--relative-to", relative_to, ["brdf", "bridf"]) from None
 
 
 def fit_domain(theta_r_max: float | None, source_exclusion: float | None

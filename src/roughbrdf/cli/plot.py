@@ -22,6 +22,7 @@ from typing import Annotated, Any
 import typer
 
 from .common import PLOT_OPTIONS, cli_model, degree_range, handled, parse_params
+from .options import OptionError, pick_channel, unknown_value
 
 KINDS = ("in-plane", "polar", "hemisphere", "mueller", "mueller-plane", "dolp")
 
@@ -54,14 +55,30 @@ def _write_png(fig: Any, path: Path, force: bool) -> Path:
     return atomic_write(path, _png(fig), overwrite=force, binary=True)
 
 
-def _model_figure(model_name: str, params: dict[str, Any], kind: str, theta_i: str,
-                  elevation: float, quantity: str, log: bool | None):
+def check_elevation(elevation: float) -> float:
+    """``--elevation DEG`` (the reflection elevation of ``--kind polar``) -> radians; refused
+    outside 0 <= DEG <= 90 (also NaN), whatever the kind, before anything is drawn.
+
+    Examples
+    --------
+    >>> check_elevation(200)
+    Traceback (most recent call last):
+    ...
+    roughbrdf.cli.options.OptionError: --elevation 200: must be a reflection elevation in ...
+    """
+    if not (math.isfinite(elevation) and 0 <= elevation <= 90):  # else worded in radians
+        raise OptionError("--elevation", f"--elevation {elevation:g}: must be a reflection "
+                                         f"elevation in degrees, 0 <= DEG <= 90")
+    return math.radians(elevation)
+
+
+def _model_figure(m: Any, kind: str, ti: Any, elevation: float, quantity: str,
+                  log: bool | None):
+    """The figure of model ``m`` (``ti``: incidences in radians, ``elevation`` in degrees)."""
     import numpy as np
 
     from .. import plot as rbplot
 
-    m = cli_model(model_name, params)  # -p angles (Oren-Nayar sigma) in degrees
-    ti = degree_range(theta_i, "--theta-i")
     if kind in ("mueller", "mueller-plane", "dolp"):
         return _polarimetric_figure(m, kind, ti)
     if kind == "in-plane":
@@ -71,10 +88,7 @@ def _model_figure(model_name: str, params: dict[str, Any], kind: str, theta_i: s
     if ti.size != 1:
         raise ValueError(f"--kind {kind} takes one --theta-i, got {ti.size}")
     if kind == "polar":
-        if not (math.isfinite(elevation) and 0 <= elevation <= 90):  # else worded in radians
-            raise ValueError(f"--elevation {elevation!r}: must be a reflection elevation in "
-                             f"degrees, 0 <= DEG <= 90")
-        return rbplot.plot_polar(m, float(ti[0]), math.radians(elevation), label=m.name)
+        return rbplot.plot_polar(m, float(ti[0]), check_elevation(elevation), label=m.name)
     return rbplot.plot_hemisphere(m, float(ti[0]), quantity=quantity,
                                   log=True if log is None else log)
 
@@ -164,12 +178,8 @@ def _fit_channels(fit: dict[str, Any], channel: str | None, out: Path | None
                   ) -> list[dict[str, Any]]:
     """The channels of ``fit`` to draw (``--channel``), checked against ``--out``."""
     chans = fit["channels"]
-    if channel is not None:
-        chans = [c for i, c in enumerate(chans) if str(c.get("channel")) == channel
-                 or str(i) == channel]
-        if not chans:
-            labels = [str(c.get("channel")) for c in fit["channels"]]
-            raise ValueError(f"no channel {channel!r} in the fit; channels: {labels}")
+    if channel is not None:  # a label or an index, as for every verb's --channel
+        chans = [chans[pick_channel([str(c.get("channel")) for c in chans], channel)]]
     if out is not None and len(chans) > 1:
         raise ValueError("--out names one file but the fit has several channels; pick one with "
                          "--channel or omit --out (files go into the fit directory)")
@@ -323,8 +333,11 @@ def _plot(model: str | None, params: dict[str, Any], kind: str, theta_i: str, el
     if out is None:
         raise ValueError("--out FILE.png is required")
     if kind not in KINDS:
-        raise ValueError(f"--kind must be one of {', '.join(KINDS)}, got {kind!r}")
+        raise unknown_value("--kind", kind, KINDS)
     q = Quantity.parse(quantity, "--quantity").value
+    check_elevation(elevation)  # every option checked before --out and the drawing
+    m = cli_model(model, params, "MODEL")  # -p angles (Oren-Nayar sigma) in degrees
+    ti = degree_range(theta_i, "--theta-i")
     _check_out(out, force)
-    fig, _ax = _model_figure(model, params, kind, theta_i, elevation, q, log)
+    fig, _ax = _model_figure(m, kind, ti, elevation, q, log)
     return [_write_png(fig, out, force)]

@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from .common import REPRODUCE_OPTIONS, handled
+from .options import unknown_value
 
 #: the library's argument names -> this verb's options (errors name the options)
 OPTIONS = REPRODUCE_OPTIONS
@@ -40,6 +41,8 @@ def register(app: typer.Typer) -> None:
             matplotlib.use("Agg")
             from .. import reproduce
 
+            if paper.strip().lower() not in (*reproduce.PAPERS, "all"):
+                raise unknown_value("--paper", paper, [*reproduce.PAPERS, "all"], "paper")
             try:
                 paths = reproduce.run(paper, out, overwrite=force, compact=compact,
                                       data_dir=data, echo=typer.echo)

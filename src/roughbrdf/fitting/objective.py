@@ -136,6 +136,46 @@ class ObjectiveSpec:
                                     and abs(b - e) <= 1e-9 * max(1.0, abs(e)))
         return out
 
+    def canonical(self, theta: np.ndarray) -> np.ndarray:
+        """``theta`` or, for a model with a label symmetry (two lobes that may trade places:
+        :meth:`~roughbrdf.models.coated.Coated.lobe_mirror`), its mirror when that puts the
+        narrower lobe first. A point and its mirror are the same model at the same cost: the
+        search keeps one of them, not both (``docs/fitting.md``, "Global search"; measured,
+        C2_Black's two Beckmann lobes explored to one end and its mirror, and both were
+        polished). ``theta`` as given unless every name of the symmetry is free and its
+        bounds map onto themselves.
+
+        Examples
+        --------
+        >>> import numpy as np, roughbrdf as rb
+        >>> spec = ObjectiveSpec(rb.model("coated", lobes=2), ["alpha", "alpha2", "w2"],
+        ...                      [0.01, 0.01, 0.0], [1.0, 1.0, 1.0])
+        >>> spec.canonical(np.array([0.3, 0.05, 0.2])).round(3).tolist()
+        [0.05, 0.3, 0.8]
+        """
+        mirror = getattr(self.model, "lobe_mirror", lambda: None)()
+        if mirror is None:
+            return theta
+        swaps, complements = mirror
+        pos = {nm: j for j, nm in enumerate(self.free)}
+        names = [nm for pair in swaps for nm in pair] + list(complements)
+        if not all(nm in pos for nm in names):
+            return theta
+        lo, hi = self.lower, self.upper
+        same = all(lo[pos[a]] == lo[pos[b]] and hi[pos[a]] == hi[pos[b]] for a, b in swaps)
+        # w -> 1 - w maps [lo, hi] onto itself only when lo = 1 - hi
+        if not same or not all(abs(lo[pos[c]] + hi[pos[c]] - 1.0) <= 1e-12 for c in complements):
+            return theta
+        first, second = swaps[0]
+        if not theta[pos[first]] > theta[pos[second]]:
+            return theta
+        out = np.array(theta, dtype=float)
+        for a, b in swaps:
+            out[pos[a]], out[pos[b]] = theta[pos[b]], theta[pos[a]]
+        for c in complements:
+            out[pos[c]] = 1.0 - theta[pos[c]]
+        return out
+
     def start_values(self) -> dict[str, float]:
         """The model's values of the free parameters (where a fit starts)."""
         params = self.model.params

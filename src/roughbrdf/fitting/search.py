@@ -254,6 +254,9 @@ def search(full: Objective, explore: Objective, starts: list[np.ndarray],
     if single:  # the first end as good as the best (first_best), in the order of the starts
         first = ends[first_best([e[0] for e in ends])]
         return SearchOutcome(first[1], first[2], tried, 0)
+    # an end and its mirror (two lobes that traded places) are one end: compared, and
+    # polished, in one form (ObjectiveSpec.canonical)
+    ends = [(c, full.spec.canonical(x), r) for c, x, r in ends]
     order = sorted(range(len(ends)), key=lambda i: ends[i][0])
     keep = _distinct([ends[i][1] for i in order], options.polish, hi - lo)
     # polished in the order of their starts, so that first_best's choice follows the starts

@@ -401,6 +401,28 @@ class Coated(Model):
         ``tests/test_coated_energy.py`` checks albedo <= 1 + 1e-3 over the whole domain)."""
         return self._options.get("weights") != "free"
 
+    def lobe_mirror(self) -> tuple[tuple[tuple[str, str], ...], tuple[str, ...]] | None:
+        """The two-lobe model's label symmetry: ``(swaps, complements)`` such that
+        exchanging the values of each pair in ``swaps`` and replacing each ``w`` in
+        ``complements`` by ``1 - w`` gives the same model (lobe 1 and lobe 2 trade places); None
+        for one or three lobes (three lobes' weights, :func:`lobe_weights`, are not symmetric
+        under a pairwise exchange). The search uses it to treat a point and its mirror as one
+        end (:meth:`~roughbrdf.fitting.objective.ObjectiveSpec.canonical`).
+
+        Examples
+        --------
+        >>> import roughbrdf as rb
+        >>> rb.model("coated", lobes=2).lobe_mirror()
+        ((('alpha', 'alpha2'),), ('w2',))
+        >>> rb.model("coated").lobe_mirror() is None
+        True
+        """
+        if self._options["lobes"] != 2:
+            return None
+        if self._options.get("weights") == "free":
+            return (("alpha", "alpha2"), ("ks", "ks2")), ()
+        return (("alpha", "alpha2"),), ("w2",)
+
     def specular_lobes(self) -> list[tuple[float, float]]:
         """``[(weight, alpha), ...]`` of the specular lobes: the weights of
         :func:`lobe_weights` (they sum to 1), or the free scales ``ks_j`` with

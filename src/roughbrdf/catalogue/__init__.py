@@ -210,7 +210,7 @@ def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model
     read_options : mapping, optional
         Passed to :func:`roughbrdf.read` (``format``, ``quantity``, ``angles``).
     candidates, cv
-        With ``model="auto"``: as for :func:`roughbrdf.fitting.compare.fit_auto`.
+        With ``model="auto"``: as for :func:`roughbrdf.fitting.auto.fit_auto`.
     time_limit : float, optional
         Seconds one task may run; a task over it is reported failed and its worker restarted.
     retries : int

@@ -82,7 +82,7 @@ def _fit_and_save(task: Task, sha: str | None, t0: float) -> list[dict[str, Any]
 
     from .. import io as _io
     from ..fitting import FitOptions, fit
-    from ..fitting.compare import fit_auto
+    from ..fitting.auto import fit_auto
     from ..output import ResultFolder
 
     meas = _io.read(task.path, **task.read_options)

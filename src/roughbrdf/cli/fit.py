@@ -311,7 +311,7 @@ def run_fit(file: str, out: str, given: ModelInput, options: FitOptions, read: R
     (:meth:`roughbrdf.output.ResultFolder.check`).
     """
     from ..fitting import fit
-    from ..fitting.compare import fit_auto
+    from ..fitting.auto import fit_auto
     from ..output import ResultFolder
 
     m, options = resolve_model(given, options)

@@ -27,7 +27,9 @@ This package face only re-exports. One job per module:
 :mod:`~roughbrdf.fitting.search`           Sobol screening, multistart exploration, polish
 :mod:`~roughbrdf.fitting.joint`            joint fits of several channels
 :mod:`~roughbrdf.fitting.polarimetric`     Mueller-matrix data, all elements at once
-:mod:`~roughbrdf.fitting.compare`          model choice: ``compare``, ``fit_auto``, CV
+:mod:`~roughbrdf.fitting.compare`          model choice: ``compare``, CV, ranking
+:mod:`~roughbrdf.fitting.auto`             ``fit_auto``: the candidates in two stages, a
+                                           candidate far behind skipped after one channel
 :mod:`~roughbrdf.fitting.statistics`       covariance, stderr, correlations, chi2, AIC/BIC,
                                            sigma, rms-log
 :mod:`~roughbrdf.fitting.result`           :class:`ChannelFit`, :class:`FitResult`, JSON,
@@ -45,7 +47,8 @@ from __future__ import annotations
 
 from ..instrument import APERTURE_POINTS, aperture_average, aperture_stencil
 from ..quantity import LOSSES, Loss
-from .compare import AUTO_CANDIDATES, ModelComparison, compare, fit_auto
+from .auto import fit_auto
+from .compare import AUTO_CANDIDATES, ModelComparison, compare
 from .data import ChannelData
 from .fit import fit
 from .objective import Objective, ObjectiveSpec

@@ -19,6 +19,8 @@ import dataclasses
 import time
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from ..errors import ArgumentError
 from ..models.factory import as_model, spec_text
 from .data import ChannelData, prepare_channel
@@ -55,7 +57,8 @@ def refuse_polarimetric_weight(options: FitOptions) -> None:
 
 
 def fit_model(model: Model | str, measurement: Measurement, options: FitOptions, *,
-              check_energy: bool = True, refit: bool = False) -> FitResult:
+              check_energy: bool = True, refit: bool = False,
+              done: list[ChannelFit] | None = None) -> FitResult:
     """Fit one model (an instance, a name or a spec; not ``"auto"``) with ``options``:
     Mueller data with :func:`~roughbrdf.fitting.polarimetric.fit_mueller`, others with
     :func:`fit_channels`. With ``check_energy``, an
@@ -63,37 +66,45 @@ def fit_model(model: Model | str, measurement: Measurement, options: FitOptions,
     reflects more than it receives (the refits of a cross-validation skip the check). With
     ``refit`` (a cross-validation fold: ``model`` holds a fit's optimum), a channel fitted
     under the energy constraint is refitted from that optimum under the constraint directly
-    (:func:`~roughbrdf.fitting.energy.refit_constrained`)."""
+    (:func:`~roughbrdf.fitting.energy.refit_constrained`). ``done``: the fits of the first
+    channels, made before by this same call with those channels alone
+    (:mod:`~roughbrdf.fitting.auto`'s first stage): kept as they are, and the search goes on
+    from them as it would have (:func:`fit_channels`); the result is the whole fit's."""
     res: FitResult
     if is_mueller(measurement):  # Mueller elements: all at once
         res = fit_mueller(model, measurement, options=options)
     else:
         refuse_polarimetric_weight(options)
         m = as_model(model)
-        res = (_by_wavelength(m, measurement, options) if needs_wavelength(m)
-               else fit_channels(m, measurement, options, refit=refit))
+        res = (_by_wavelength(m, measurement, options, done) if needs_wavelength(m)
+               else fit_channels(m, measurement, options, refit=refit, done=done))
     if check_energy:
         warn_energy(res, stacklevel=4)
     return res
 
 
-def _by_wavelength(model: Model, measurement: Measurement, options: FitOptions) -> FitResult:
+def _by_wavelength(model: Model, measurement: Measurement, options: FitOptions,
+                   done: list[ChannelFit] | None = None) -> FitResult:
     """A model that needs the wavelength (:mod:`~roughbrdf.fitting.wavelengths`): each channel
-    fitted with the model at that channel's wavelength, the results in one."""
+    fitted with the model at that channel's wavelength, the results in one (those ``done``
+    kept: each channel is fitted on its own)."""
     if options.joint:
         raise ArgumentError("joint", "the model depends on the wavelength, which differs from "
                             "channel to channel: fit the channels separately", value=True)
+    kept = list(done or [])
     results = [fit_channels(with_wavelength(model, channel_wavelength(
         measurement, j, options.wavelength)), measurement, options.replace(channel=[j]))
-        for j in channel_indices(measurement, options.channel)]
-    return dataclasses.replace(results[0], channels=[c for r in results for c in r.channels],
+        for j in channel_indices(measurement, options.channel)[len(kept):]]
+    return dataclasses.replace(results[0], channels=kept + [c for r in results
+                                                            for c in r.channels],
                                elapsed=sum(r.elapsed for r in results))
 
 
 def fit_channels(model: Model, measurement: Measurement, options: FitOptions, *,
-                 refit: bool = False) -> FitResult:
+                 refit: bool = False, done: list[ChannelFit] | None = None) -> FitResult:
     """Fit ``model`` to the channels of ``measurement`` (not Mueller data), each on its own
-    or, with ``options.joint``, all at once; ``refit`` as :func:`fit_model`'s."""
+    or, with ``options.joint``, all at once; ``refit`` and ``done`` as :func:`fit_model`'s
+    (``done`` is for channels fitted on their own)."""
     t_start = time.perf_counter()
     chans = channel_indices(measurement, options.channel)
     plan = FitPlan.of(model, measurement, options)
@@ -111,22 +122,30 @@ def fit_channels(model: Model, measurement: Measurement, options: FitOptions, *,
             results, summary = fit_joint(spec, data, search, options.shared, tick)
         else:
             results, summary = _separately(spec, search, data, bar, tick,
-                                           options.energy_constraint, refit), None
+                                           options.energy_constraint, refit, done), None
     return FitResult(channels=results, **plan.result_fields(
         measurement, time.perf_counter() - t_start, joint=summary,
         energy_constraint=options.energy_constraint and not joint))
 
 
 def _separately(spec: ObjectiveSpec, search: SearchOptions, data: list[ChannelData],
-                bar: Any, tick: Any, energy: bool = True, refit: bool = False
-                ) -> list[ChannelFit]:
+                bar: Any, tick: Any, energy: bool = True, refit: bool = False,
+                done: list[ChannelFit] | None = None) -> list[ChannelFit]:
     """Each channel on its own, in order (the previous optimum is a warm start); with
     ``energy``, a channel whose model gains energy refitted under the constraint; with
     ``refit``, a model that cannot guarantee energy refitted from its values under the
-    constraint directly (:func:`~roughbrdf.fitting.energy.refit_constrained`)."""
-    results: list[ChannelFit] = []
+    constraint directly (:func:`~roughbrdf.fitting.energy.refit_constrained`). The fits
+    ``done`` of the first channels are kept, and the search state they left is restored: the
+    subsample draws they made, their optimum as the next warm start."""
+    results: list[ChannelFit] = list(done or [])
     runner = MultiStart(spec, search, tick)
-    for d in data:
+    for d, fit in zip(data, results, strict=False):
+        runner.objectives(d)  # the same random subsample draw as when it was fitted
+        runner.warm = np.array([fit.params[nm] for nm in spec.free], dtype=float)
+        if tick is not None:
+            for _ in range(search.starts):
+                tick()
+    for d in data[len(results):]:
         t0 = time.perf_counter()
         if bar is not None:
             bar.set_postfix_str(d.label)

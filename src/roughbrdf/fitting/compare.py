@@ -43,7 +43,6 @@ not predicted from their neighbours (``docs/fitting.md``, "Model choice", gives 
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -56,7 +55,7 @@ from ..models.factory import split_specs
 from ..quantity import Loss
 from .channels import fit_model
 from .options import FitOptions, default_loss
-from .plausibility import ENERGY_TOLERANCE, EnergyWarning, warn_energy
+from .plausibility import ENERGY_TOLERANCE
 from .search import progress_bar
 
 if TYPE_CHECKING:
@@ -64,7 +63,9 @@ if TYPE_CHECKING:
     from .result import FitResult
 
 __all__ = ["AUTO_CANDIDATES", "THETA_R_BANDS", "Candidate", "ModelComparison", "choice_notes",
-           "compare", "cross_validate", "fit_auto", "information", "LOBE_OFF", "lobes_off", "rank"]
+           "candidate", "compare", "comparison", "cross_validate", "held_out_residuals",
+           "information", "LOBE_OFF", "lobes_off", "rank", "rms", "score_metric",
+           "as_candidates"]
 
 #: the candidates of ``--model auto`` for non-retroreflective materials (paints, plastics,
 #: coatings, ceramics): TR75 as published, then the coated model with one and two specular
@@ -119,6 +120,10 @@ class Candidate:
     bands: dict[str, float]
     cv: float | None = None
     elapsed: float = math.nan
+    #: why the candidate was fitted on part of the channels only (``--model auto`` skips a
+    #: candidate far behind after the first channel: :mod:`~roughbrdf.fitting.auto`); None
+    #: for a whole fit
+    partial: str | None = None
 
     def row(self) -> dict[str, Any]:
         """The table row as plain values (``fit.json``)."""
@@ -129,7 +134,7 @@ class Candidate:
                 "bic": self.bic, "sigma": self.sigma, "rms_log": self.rms_log,
                 "rms_log_by_theta_r": self.bands, "cv": self.cv, "params": params,
                 "limits": {c.channel: c.limits for c in res.channels},
-                "plausibility": plaus, "elapsed_s": self.elapsed}
+                "plausibility": plaus, "elapsed_s": self.elapsed, "partial": self.partial}
 
     @property
     def max_albedo(self) -> float:
@@ -182,13 +187,16 @@ class ModelComparison:
 
     @property
     def best_bic(self) -> Candidate:
-        """The lowest BIC (which may not be :attr:`best`)."""
-        return min(self.candidates, key=lambda c: c.bic)
+        """The lowest BIC (which may not be :attr:`best`) of the candidates fitted on every
+        channel (one fitted on fewer samples has a lower BIC that means nothing)."""
+        whole = [c for c in self.candidates if c.partial is None] or self.candidates
+        return min(whole, key=lambda c: c.bic)
 
     @property
     def best_cv(self) -> Candidate | None:
         """The lowest cross-validation score (None without one)."""
-        scored = [c for c in self.candidates if c.cv is not None and math.isfinite(c.cv)]
+        scored = [c for c in self.candidates if c.cv is not None and math.isfinite(c.cv)
+                  and c.partial is None]
         return min(scored, key=lambda c: c.cv) if scored else None  # type: ignore[arg-type,return-value]
 
     def table(self) -> str:
@@ -200,7 +208,8 @@ class ModelComparison:
         lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
         b0, a0 = self.best_bic.bic, min(c.aic for c in self.candidates)
         for c in self.candidates:
-            cells = [c.label, str(c.k), f"{c.sigma:.3f}", f"{c.rms_log:.3f}",
+            cells = [c.label + (" (first channel only)" if c.partial else ""), str(c.k),
+                     f"{c.sigma:.3f}", f"{c.rms_log:.3f}",
                      f"{c.bic - b0:.0f}", f"{c.aic - a0:.0f}",
                      "-" if c.cv is None else f"{c.cv:.4f}",
                      *[_num(c.bands[b]) for b in bands],
@@ -306,12 +315,27 @@ def cross_validate(result: FitResult, options: FitOptions | Mapping[str, Any], *
     ``metric="log"`` ``ln(K x) - ln f`` (one yardstick for candidates fitted with different
     losses, :func:`compare`). A progress bar (``options.progress``) names the candidate
     (``label``, default the fit's model), the fold's incidence and the channel."""
+    if result.measurement.incidences().size < 2:
+        return math.nan
+    return rms(held_out_residuals(result, options, label=label, metric=metric))
+
+
+def rms(residuals: np.ndarray) -> float:
+    """The r.m.s. of the finite ``residuals`` (NaN without one): a cross-validation score."""
+    r = residuals[np.isfinite(residuals)]
+    return float(np.sqrt(np.mean(r * r))) if r.size else math.nan
+
+
+def held_out_residuals(result: FitResult, options: FitOptions | Mapping[str, Any], *,
+                       label: str | None = None, metric: str | None = None) -> np.ndarray:
+    """The left-out residuals of every fold and channel of :func:`cross_validate` (whose
+    score is their r.m.s., :func:`rms`); empty with a single incidence."""
     if not isinstance(options, FitOptions):
         options = FitOptions.of(None, options, caller="cross_validate")
     meas = result.measurement
     angles = meas.incidences()
     if angles.size < 2:
-        return math.nan
+        return np.array([])
     joint = bool(result.options.get("joint"))
     # one local fit on all training samples from the full optimum (no exploration stage: the
     # start is already in the basin)
@@ -323,9 +347,7 @@ def cross_validate(result: FitResult, options: FitOptions | Mapping[str, Any], *
             out = np.abs(meas.theta_i - g) < 1e-6
             held += _fold(result, options, meas.subset(~out), out, groups, bar,
                           f"theta_i {math.degrees(g):g} deg", metric)
-    r = np.concatenate(held) if held else np.array([])
-    r = r[np.isfinite(r)]
-    return float(np.sqrt(np.mean(r * r))) if r.size else math.nan
+    return np.concatenate(held) if held else np.array([])
 
 
 def _fold(result: FitResult, options: FitOptions, train: Measurement, out: np.ndarray,
@@ -373,7 +395,7 @@ def _subset_weights(weights: Any, n: int, keep: np.ndarray) -> Any:
     return w[keep] if w.ndim >= 1 and w.shape[0] == n else weights
 
 
-def _as_candidates(candidates: Sequence[Model | str] | str | None) -> list[Model]:
+def as_candidates(candidates: Sequence[Model | str] | str | None) -> list[Model]:
     """The candidate models (ArgumentError naming ``candidates`` for a bad one)."""
     if candidates is None:
         candidates = AUTO_CANDIDATES
@@ -436,21 +458,40 @@ def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | 
     if options is None:  # a progress bar per candidate only when asked for
         keywords = {"progress": False, **keywords}
     options = FitOptions.of(options, keywords, caller="compare")
-    models = _as_candidates(candidates)
+    models = as_candidates(candidates)
     # candidates fitted with different losses (loss="auto": robust, relative for TR75 ...)
     # have scores in different units: they are scored on one yardstick, the log residual
-    losses = {default_loss(m, options.loss) for m in models}
-    metric = "log" if len(losses) > 1 else None
+    metric, losses = score_metric(models, options)
     rows: list[Candidate] = []
     for m in models:
         res = fit_model(m, measurement, options)
-        k, n, aic, bic = information(res)
-        rows.append(Candidate(
-            spec_text(m), res, k, n, aic, bic,
-            float(np.median([c.sigma for c in res.channels])),
-            float(np.median([c.rms_log for c in res.channels])), band_rms_log(res),
-            cross_validate(res, options, label=spec_text(m), metric=metric) if cv else None,
-            res.elapsed))
+        score = cross_validate(res, options, label=spec_text(m), metric=metric) if cv else None
+        rows.append(candidate(spec_text(m), res, score))
+    return comparison(rows, measurement, losses)
+
+
+def score_metric(models: Sequence[Model], options: FitOptions) -> tuple[str | None, set[str]]:
+    """The held-out metric of :func:`compare` (``"log"`` when the candidates are fitted with
+    different losses: one yardstick for all; None: each one's loss) and the losses."""
+    losses = {default_loss(m, options.loss) for m in models}
+    return ("log" if len(losses) > 1 else None), losses
+
+
+def candidate(label: str, res: FitResult, cv: float | None, partial: str | None = None
+              ) -> Candidate:
+    """The table row of a fitted candidate (information criteria, medians, bands)."""
+    k, n, aic, bic = information(res)
+    return Candidate(label, res, k, n, aic, bic,
+                     float(np.median([c.sigma for c in res.channels])),
+                     float(np.median([c.rms_log for c in res.channels])), band_rms_log(res),
+                     cv, res.elapsed, partial)
+
+
+def comparison(rows: list[Candidate], measurement: Measurement, losses: set[str]
+               ) -> ModelComparison:
+    """The :class:`ModelComparison` of fitted candidates: ranked (:func:`rank`), with the
+    notes that say how to read it."""
+    metric = "log" if len(losses) > 1 else None
     rows, criterion = rank(rows)
     if metric == "log":
         notes_metric = ["the candidates were fitted with different losses "
@@ -462,7 +503,7 @@ def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | 
              "models' systematic misfit, so differences of this size overstate the evidence. "
              "CV: r.m.s. loss residual of each incidence predicted by a fit without it "
              "(lower is better)."]
-    if len({c.n_points for c in rows}) > 1:
+    if len({c.n_points for c in rows if c.partial is None}) > 1:
         notes.append("the candidates were fitted on different numbers of samples (the "
                      "model's own domain differs): their AIC/BIC are not comparable")
     notes += choice_notes(ModelComparison(rows, measurement, criterion=criterion))
@@ -476,14 +517,16 @@ def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | 
 def rank(rows: Sequence[Candidate]) -> tuple[list[Candidate], str]:
     """The candidates best first and the criterion (module notes): ``"cv"`` when every
     candidate has a finite cross-validation score, else ``"bic"``; those that gain energy
-    last. Ties keep the given order."""
+    last; one fitted on part of the channels (:attr:`Candidate.partial`) after every whole
+    one. Ties keep the given order."""
     cv = all(c.cv is not None and math.isfinite(c.cv) for c in rows)
     criterion = "cv" if cv else "bic"
 
-    def key(c: Candidate) -> tuple[bool, float, int]:
-        # equal scores (a lobe switched off: the smaller model's fit): the fewer unknowns
+    def key(c: Candidate) -> tuple[bool, bool, float, int]:
+        # equal scores (a lobe switched off: the smaller model's fit): the fewer unknowns;
+        # a candidate fitted on the first channel only (skipped) after every whole one
         score = float(f"{c.cv:.6g}") if cv else c.bic  # type: ignore[arg-type]
-        return c.gains_energy, score, c.k
+        return c.partial is not None, c.gains_energy, score, c.k
 
     return sorted(rows, key=key), criterion
 
@@ -506,34 +549,10 @@ def choice_notes(cmp: ModelComparison) -> list[str]:
             what = ", ".join(f"lobe {j} in {ch} (weight {w:.1g})" for ch, j, w, _ in off)
             notes.append(f"{c.label}: {what} below {LOBE_OFF:g}: switched off, counted as the "
                          f"smaller model (k = {c.k})")
+    for c in cmp.candidates:
+        if c.partial:
+            notes.append(f"{c.label}: {c.partial}")
     if any(c.gains_energy for c in cmp.candidates):
         notes.append("candidates whose fitted model gains energy rank last, whatever their "
                      "score")
     return notes
-
-
-def fit_auto(measurement: Measurement, candidates: Sequence[Model | str] | str | None = None,
-             *, cv: bool = True, options: FitOptions | None = None,
-             **keywords: Any) -> FitResult:
-    """``rb.fit("auto", ...)``: :func:`compare` the candidates and return the best (by the
-    cross-validation score, BIC without one; :func:`rank`),
-    with the comparison attached (``FitResult.model_choice``: in ``fit.json``, the report and
-    ``compare.png``). ``options`` and ``keywords`` as for :func:`compare`; ``fix`` and
-    ``bounds`` are refused (ArgumentError)."""
-    given = FitOptions.of(options, keywords, caller="fit_auto")
-    for name in ("fix", "bounds"):
-        value = getattr(given, name)
-        if value:
-            raise ArgumentError(name, "names parameters of one model; with model 'auto' the "
-                                "candidates have different parameters: choose the model, or "
-                                "compare candidates (rb.compare)", value=value)
-    keywords = {k: v for k, v in keywords.items() if k not in ("fix", "bounds")}
-    with warnings.catch_warnings():  # the candidates not chosen do not matter: the best's below
-        warnings.simplefilter("ignore", EnergyWarning)
-        choice = compare(measurement, candidates, cv=cv, options=options, **keywords)
-    best = choice.best.result
-    warn_energy(best, stacklevel=3)
-    best.model_choice = choice
-    best.model_name = choice.best.label
-    best.elapsed = sum(c.result.elapsed for c in choice.candidates)
-    return best

@@ -4,7 +4,7 @@
 one, ``options=``) and sends the work on: Mueller data to
 :func:`~roughbrdf.fitting.polarimetric.fit_mueller` and a named model to
 :func:`~roughbrdf.fitting.channels.fit_model`, ``"auto"`` to model choice
-(:func:`~roughbrdf.fitting.compare.fit_auto`). No module of the package imports this one:
+(:func:`~roughbrdf.fitting.auto.fit_auto`). No module of the package imports this one:
 model choice fits its candidates through :mod:`~roughbrdf.fitting.channels`.
 """
 
@@ -13,8 +13,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from ..models.factory import is_auto
+from .auto import fit_auto
 from .channels import fit_model, is_mueller, refuse_polarimetric_weight
-from .compare import fit_auto
 from .options import FitOptions
 
 if TYPE_CHECKING:
@@ -37,7 +37,7 @@ def fit(model: Model | str, measurement: Measurement, *, options: FitOptions | N
         :data:`~roughbrdf.fitting.compare.AUTO_CANDIDATES` and keep the best by
         cross-validation (BIC beside it), with
         every candidate's figures and a leave-one-incidence-out score in ``model_choice``
-        (:func:`~roughbrdf.fitting.compare.fit_auto`; ``fix`` and ``bounds`` do not apply).
+        (:func:`~roughbrdf.fitting.auto.fit_auto`; ``fix`` and ``bounds`` do not apply).
     measurement : Measurement
         The data (:func:`roughbrdf.read`).
     options : FitOptions, optional

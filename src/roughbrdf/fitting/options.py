@@ -2,7 +2,7 @@
 
 :func:`roughbrdf.fit` takes them as keywords (``rb.fit(model, meas, loss="log")``: the
 keywords build a :class:`FitOptions`) or typed (``rb.fit(model, meas, options=opts)``);
-:func:`~roughbrdf.fitting.compare.compare`, :func:`~roughbrdf.fitting.compare.fit_auto`,
+:func:`~roughbrdf.fitting.compare.compare`, :func:`~roughbrdf.fitting.auto.fit_auto`,
 :func:`~roughbrdf.fitting.polarimetric.fit_mueller`, :class:`~roughbrdf.fitting.plan.FitPlan`,
 :func:`roughbrdf.catalogue.fit_catalogue` and the command line pass one along. Every check that
 needs no measurement nor model runs when the options are made (an

@@ -1,0 +1,98 @@
+"""``--model auto`` in two stages (``roughbrdf.fitting.auto``): a candidate far behind on the
+first channel is skipped, and the candidates fitted further get the fit ``rb.compare`` makes.
+
+What is protected: the choice and every kept candidate's fit are those of the whole comparison
+(the skip only saves time), a skipped candidate says so and ranks after every whole one, and
+the search resumed after the first channel (``fit_model(..., done=...)``) is the whole fit's.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+import pytest
+
+import roughbrdf as rb
+import roughbrdf.fitting.auto  # noqa: F401  (the module, not the function of the same name)
+from roughbrdf.fitting.channels import fit_model
+from roughbrdf.fitting.options import FitOptions
+
+auto = sys.modules["roughbrdf.fitting.auto"]
+
+TRUTH = rb.model("coated", n=1.5, rho=0.3, alpha=0.15)
+CANDIDATES = ["lambertian", "coated", "coated(lobes=2)"]
+STARTS = 3
+
+
+def _measurement(channels: int = 3) -> rb.Measurement:
+    """The coated model with three diffuse levels, 2 % noise, incidences 10, 35, 60 deg."""
+    g = list(np.radians(np.mgrid[10:61:25, 0:81:8, 0:181:45].reshape(3, -1)))
+    rng = np.random.default_rng(3)
+    clean = np.stack([TRUTH.with_values(["rho"], [0.3 + 0.2 * j]).brdf(*g)
+                      for j in range(channels)], axis=1)
+    return rb.Measurement(*g, clean * (1 + 0.02 * rng.standard_normal(clean.shape)),
+                          channels=[f"c{j}" for j in range(channels)])
+
+
+@pytest.fixture(scope="module")
+def meas() -> rb.Measurement:
+    return _measurement()
+
+
+@pytest.fixture(scope="module")
+def both(meas):
+    whole = rb.compare(meas, CANDIDATES, starts=STARTS)
+    staged = auto.fit_auto(meas, CANDIDATES, starts=STARTS)
+    return whole, staged
+
+
+def test_the_far_candidate_is_skipped_and_says_so(both):
+    whole, staged = both
+    rows = {c.label: c for c in staged.model_choice.candidates}
+    # the Lambertian model cannot make the specular lobe: its first-channel score is many
+    # times the coated model's (far beyond the 1 + SKIP_MARGIN factor)
+    skipped = rows["lambertian"]
+    assert skipped.partial is not None and "fitted to channel c0 only" in skipped.partial
+    assert [c.channel for c in skipped.result.channels] == ["c0"]
+    assert staged.model_choice.candidates[-1] is skipped  # after every whole candidate
+    assert any("lambertian: fitted to channel c0 only" in n for n in staged.model_choice.notes)
+    row = json.loads(staged.to_json())["model_choice"]["candidates"]
+    assert [r["partial"] is not None for r in row] == [False, False, True]
+    assert "lambertian (first channel only)" in staged.model_choice.table()
+    # a whole candidate's BIC is not compared with one over fewer samples
+    assert staged.model_choice.best_bic.partial is None
+
+
+def test_the_choice_and_the_kept_fits_are_the_whole_comparisons(both):
+    whole, staged = both
+    assert staged.model_name == whole.best.label
+    rows = {c.label: c for c in staged.model_choice.candidates}
+    for c in whole.candidates:
+        if rows[c.label].partial:
+            continue
+        mine = rows[c.label]
+        # the same fit to the last bit: the search went on from the first channel's state
+        for a, b in zip(c.result.channels, mine.result.channels, strict=True):
+            assert a.params == b.params and a.chi2 == b.chi2
+        assert mine.cv == pytest.approx(c.cv, rel=1e-12)  # the same folds' residuals
+
+
+def test_the_resumed_search_is_the_whole_fit(meas):
+    opts = FitOptions(starts=STARTS, progress=False)
+    whole = fit_model("coated(lobes=2)", meas, opts)
+    first = fit_model("coated(lobes=2)", meas, opts.replace(channel=[0]))
+    resumed = fit_model("coated(lobes=2)", meas, opts, done=first.channels)
+    assert resumed.channels[0] is first.channels[0]
+    for a, b in zip(whole.channels, resumed.channels, strict=True):
+        assert a.params == b.params
+
+
+def test_one_channel_or_no_score_compares_every_candidate_whole():
+    one = _measurement(channels=1)
+    res = auto.fit_auto(one, CANDIDATES, starts=1)
+    assert not any(c.partial for c in res.model_choice.candidates)
+    res = auto.fit_auto(_measurement(channels=2), CANDIDATES, starts=1, cv=False)
+    assert not any(c.partial for c in res.model_choice.candidates)
+    assert res.model_choice.criterion == "bic"

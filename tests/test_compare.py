@@ -150,7 +150,8 @@ def test_table_to_dict_and_plot(comparison):
     row = d["candidates"][0]
     assert set(row) == {"model", "k", "n_points", "aic", "bic", "sigma", "rms_log",
                         "rms_log_by_theta_r", "cv", "params", "limits", "plausibility",
-                        "elapsed_s"}
+                        "elapsed_s", "partial"}
+    assert row["partial"] is None  # rb.compare fits every candidate on every channel
     assert set(row["params"]) == {"c0", "c1"} and set(row["params"]["c0"]) == {
         "n", "rho", "alpha"}
     json.dumps(d)  # plain values

@@ -19,9 +19,9 @@ venv: $(STAMP)
 demo: $(STAMP)
 	$(PY) -m roughbrdf.demo --out out --force
 
-# Debian's Chromium and chromedriver for the browser tests (tests/test_catalogue_summary.py):
-# installed quietly when missing and running as root with apt-get; nothing is downloaded by a
-# test tool. Elsewhere those tests skip and say why.
+# Debian's Chromium and chromedriver for the browser tests
+# (tests/catalogue/test_catalogue_summary.py): installed quietly when missing and running as root
+# with apt-get; nothing is downloaded by a test tool. Elsewhere those tests skip and say why.
 browser:
 	@if [ ! -x /usr/bin/chromium ] || [ ! -x /usr/bin/chromedriver ]; then \
 	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
@@ -49,11 +49,12 @@ test: $(STAMP) browser
 # OpenBLAS's Haswell kernels, as on such a machine (docs/fitting.md, "The same answer on every
 # machine"). NUMBA_CPU_FEATURES is set empty on purpose: numba otherwise keeps the host's
 # features (AVX-512) under NUMBA_CPU_NAME=haswell. A machine's own OPENBLAS_CORETYPE stands.
-ROUNDING_TESTS := tests/test_auto_energy.py tests/test_energy_constraint.py \
-	tests/test_fitting_real.py tests/test_constrained.py tests/test_bounded.py \
-	tests/test_fitting.py tests/test_compare.py tests/test_fit_limits.py \
-	tests/test_fit_energy.py tests/test_fit_scale_hold.py tests/test_same_answer.py \
-	tests/test_auto_stages.py
+ROUNDING_TESTS := tests/fitting/test_auto_energy.py tests/fitting/test_energy_constraint.py \
+	tests/fitting/test_fitting_real.py tests/fitting/test_constrained.py \
+	tests/fitting/test_bounded.py tests/fitting/test_fitting.py tests/fitting/test_compare.py \
+	tests/fitting/test_fit_limits.py tests/fitting/test_fit_energy.py \
+	tests/fitting/test_fit_scale_hold.py tests/fitting/test_same_answer.py \
+	tests/fitting/test_auto_stages.py
 # On a processor without AVX-512 the suite has just run with that processor's own AVX2 (or
 # narrower) kernels: the pass is not repeated (and haswell code could not run on a processor
 # without AVX2); it says so.

@@ -7,7 +7,7 @@ browser with ``performance.now()``.
 
 How: ``roughbrdf explore C2_Black.astm --model coated --no-browser`` runs in a subprocess (the
 real command, its Werkzeug server); Debian's headless Chromium (selenium, the pinned flags and
-SwiftShader WebGL of ``tests/test_explore_browser.py``) opens the printed address. Each
+SwiftShader WebGL of ``tests/explore/test_explore_browser.py``) opens the printed address. Each
 measurement types a new ``alpha`` into the parameter's field and presses Enter (the field's
 change event, ``dcc.Input(debounce=True)``): the page records ``performance.now()`` at that
 Enter (a capture listener on the document), at the moment Plotly assigns the graph's new
@@ -66,7 +66,7 @@ WARM = 2
 ALPHAS = ("0.08", "0.12")
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 CHROMEDRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
-#: as tests/test_explore_browser.py (WebGL by SwiftShader: software, no GPU)
+#: as tests/explore/test_explore_browser.py (WebGL by SwiftShader: software, no GPU)
 FLAGS = ("--headless", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
          "--disable-quic", "--no-first-run", "--disable-background-networking",
          "--disable-component-update", "--disable-sync", "--window-size=1400,1000")

@@ -23,7 +23,7 @@ Needs ``../shared/data`` (or ``ROUGHBRDF_SHARED_DATA``); prints a note and retur
    aperture=...)``, ``APERTURE_DEG`` half-angle; the aperture fit starts from the plain fit):
    retro peak heights, measured vs the model as the instrument would read it (averaged over the
    aperture), per incidence. With ``--scan`` the fit cost is also tabulated against the aperture
-   (on the test subset of ``tests/test_fitting_real.py``), which is how ``APERTURE_DEG`` was
+   (on the test subset of ``tests/fitting/test_fitting_real.py``), which is how ``APERTURE_DEG`` was
    chosen. With ``--docs`` the fit plots are saved as ``docs/img/rb08_<file>.png``: the
    panels of ``FitResult.plot`` (drawn through the fit's aperture) and a zoom on the retro peak
    with the model at each direction and through the aperture.
@@ -283,7 +283,7 @@ def retro_peak_text(meas, res) -> tuple[str, str]:
 
 def rb08_scan() -> None:
     """Fit cost vs aperture on the test subset (every 6th sample + all within 3 deg of retro),
-    each aperture fit starting from the plain fit, as in tests/test_fitting_real.py."""
+    each aperture fit starting from the plain fit, as in tests/fitting/test_fitting_real.py."""
     print("### RB08: fit cost vs aperture (test subset; plain fit 8 starts, aperture fits 2 "
           "starts from it)\n")
     print("| file | aperture (deg) | weighted chi2 (log loss) | sigma | rms-log | "

@@ -4,10 +4,10 @@ A test asserts on what a time stood for (``tests/test_suite_rules.py`` forbids t
 assertions); the times themselves are measured here, as figures:
 
 1. reading the real files: the three Mini-Diff ASTM files (12,964 rows each) and the CEA ALTA
-   gray tape (7,405 rows), in this process after one untimed read (``tests/test_io_astm.py``
-   and ``tests/test_io_alta.py`` check that their rows are parsed in one block);
+   gray tape (7,405 rows), in this process after one untimed read (``tests/io/test_io_astm.py``
+   and ``tests/io/test_io_alta.py`` check that their rows are parsed in one block);
 2. ``roughbrdf.catalogue.summary.write_summary`` of 100,000 synthetic rows, and the size of its
-   page (``tests/test_catalogue_summary.py`` checks that the page is paged);
+   page (``tests/catalogue/test_catalogue_summary.py`` checks that the page is paged);
 3. opening that page in headless Chromium and sorting it by one column, where Chromium,
    chromedriver and selenium are installed (``make browser``).
 

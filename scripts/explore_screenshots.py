@@ -7,7 +7,7 @@
 temporary folder, runs ``roughbrdf explore --fit out/C2_Black --no-browser`` there (the fit's
 measurement re-read from the path its ``fit.json`` records) and opens its address in Debian's
 headless Chromium (selenium; the pinned flags and SwiftShader WebGL of
-``tests/test_explore_browser.py``) at a fixed window size (:data:`WINDOW`). For each view
+``tests/explore/test_explore_browser.py``) at a fixed window size (:data:`WINDOW`). For each view
 (3-D lobe, cuts, hemisphere maps, albedo, Mueller, compare) it opens the tab, waits for the
 figure and its drawing, checks that the plot is not blank and saves the window as
 ``explore_<view>.png``. For the compare view, ``alpha`` is first typed as twice its fitted value,
@@ -44,7 +44,7 @@ MODEL = "coated"
 WINDOW = (1500, 1250)
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 CHROMEDRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
-#: as tests/test_explore_browser.py (WebGL by SwiftShader: software, no GPU)
+#: as tests/explore/test_explore_browser.py (WebGL by SwiftShader: software, no GPU)
 FLAGS = ("--headless", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
          "--disable-quic", "--no-first-run", "--disable-background-networking",
          "--disable-component-update", "--disable-sync", "--hide-scrollbars",

@@ -1,4 +1,4 @@
-"""Reference Mueller matrices from NIST SCATMECH (pySCATMECH) for ``tests/test_mueller.py``.
+"""Reference Mueller matrices from NIST SCATMECH (pySCATMECH) for ``tests/core/test_mueller.py``.
 
 Run with a Python that has pySCATMECH (it is not a dependency of roughbrdf; it builds SCATMECH
 from source)::

@@ -72,8 +72,8 @@ def pytest_runtest_teardown(item: pytest.Item) -> None:
 @pytest.fixture(autouse=True)
 def _sigint_handler_kept():
     """Every test leaves the SIGINT handler as it found it; one that does not fails, and the
-    handler is put back so that the tests after it (Ctrl-C handling, tests/test_output.py,
-    tests/test_cli_interrupts.py) are not failed by it."""
+    handler is put back so that the tests after it (Ctrl-C handling, tests/core/test_output.py,
+    tests/cli/test_cli_interrupts.py) are not failed by it."""
     import signal
 
     before = signal.getsignal(signal.SIGINT)

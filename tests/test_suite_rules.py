@@ -29,6 +29,7 @@ from pathlib import Path
 
 import pytest
 
+#: the suite: tests/ and its folders (tests/<subpackage>/, tests/core/)
 TESTS = Path(__file__).parent
 #: the clocks, by module
 CLOCKS = {
@@ -174,8 +175,9 @@ def _own_statements(stmt: ast.AST) -> list[ast.AST]:
 # the rule on the suite
 # --------------------------------------------------------------------------------------------
 def test_no_test_asserts_on_elapsed_time():
-    found = [hit for path in sorted(TESTS.glob("*.py"))
-             for hit in timed_assertions(path.read_text(encoding="utf-8"), path.name)]
+    found = [hit for path in sorted(TESTS.rglob("*.py"))
+             for hit in timed_assertions(path.read_text(encoding="utf-8"),
+                                         path.relative_to(TESTS).as_posix())]
     assert found == [], "assert on what the time stood for; figures go to benchmarks/:\n" + \
         "\n".join(found)
 

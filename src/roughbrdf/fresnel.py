@@ -251,7 +251,7 @@ def reflectance(
 #: Gauss-Legendre rule on [0, 1] in ``mu = cos theta`` for :func:`diffuse_reflectance`: the
 #: integrand ``R(mu) mu`` is smooth on [0, 1] for ``k = 0`` (no kink: the critical angle of
 #: internal reflection is handled by the identity below, not by quadrature); 64 points give it
-#: to 1e-12 (checked against 4096 points in tests/test_coated.py)
+#: to 1e-12 (checked against 4096 points in tests/models/test_coated.py)
 _GL_POINTS = 64
 
 

@@ -32,7 +32,7 @@ azimuth increases counter-clockwise seen from above the sample::
 ``radial`` is a true angle on the sphere (not a projected distance of direction cosines) and
 runs past 90 deg, up to ``90 + t`` toward the normal; ``theta_r > pi/2`` is below the horizon.
 This is also the specular coordinate system of libbsdf (K. Ryo, ``SpecularCoordinateSystem``,
-MPL-2.0); the azimuth origin is pinned by public measured files (``tests/test_io_zemax.py``).
+MPL-2.0); the azimuth origin is pinned by public measured files (``tests/io/test_io_zemax.py``).
 """
 
 from __future__ import annotations

@@ -25,7 +25,7 @@ azimuths on each ring and alternate rings staggered. ``points`` chooses the rule
 ====  ======================  ==============================================================
 
 so a constant and any quadratic function of direction are averaged exactly by every rule
-(``tests/test_fitting.py`` checks each degree against a 40 x 64-point product rule).
+(``tests/fitting/test_fitting.py`` checks each degree against a 40 x 64-point product rule).
 
 Near grazing, nodes of the cone below the surface are clipped to the horizon (``theta_r = 90``
 deg, same azimuth, :func:`aperture_directions`): BRDF cos(theta_r) is 0 there for every model,

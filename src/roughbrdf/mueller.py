@@ -6,7 +6,7 @@ irradiance to the Stokes vector of the reflected radiance, ``S_r = M S_i`` with 
 convention below is NIST SCATMECH's (``docs/convent.htm``, ``code/jmatrix.cpp``,
 ``code/brdf.cpp``, SCATMECH 7.x), so that ``model.mueller`` and SCATMECH's
 ``BRDF_Model::Mueller(thetai, thetas, phis, 0, psps|xyxy)`` agree element by element
-(``docs/models.md`` §11; ``tests/test_mueller.py``).
+(``docs/models.md`` §11; ``tests/core/test_mueller.py``).
 
 Conventions
 -----------

@@ -4,7 +4,7 @@ Numba's LLVM has no vector math library here (no SVML), so a loop that calls ``m
 ``math.exp`` and the like stays a loop of scalar libm calls. The functions here are written
 without libm calls and with selects instead of branches; a model loop built from them
 vectorizes. Each states its accuracy and is tested against NumPy/SciPy over the range it is
-used on (``tests/test_vmath.py``).
+used on (``tests/kernels/test_vmath.py``).
 
 ==============  ======================================  =================  ====================
 function        method (source of the coefficients)     measured accuracy  used by
@@ -24,8 +24,9 @@ function        method (source of the coefficients)     measured accuracy  used 
 ==============  ======================================  =================  ====================
 
 (ulp: the spacing of doubles at the exact value, ``np.spacing``; measured in
-``tests/test_vmath.py`` against NumPy, against SciPy and a 60-digit ``decimal`` reference for
-erfc, on the FMA-contracted compiled code and on the plain-Python path, which agree to 2 ulp.)
+``tests/kernels/test_vmath.py`` against NumPy, against SciPy and a 60-digit ``decimal``
+reference for erfc, on the FMA-contracted compiled code and on the plain-Python path, which
+agree to 2 ulp.)
 
 Writing rules, followed by every function here:
 

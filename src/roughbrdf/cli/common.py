@@ -2,7 +2,7 @@
 
 Like every module of :mod:`roughbrdf.cli`, this one imports nothing heavy at module level (NumPy,
 the models, SciPy, Matplotlib are imported inside the functions that use them), so that
-``roughbrdf --help`` and the argument checks stay fast; ``tests/test_startup.py`` checks it.
+``roughbrdf --help`` and the argument checks stay fast; ``tests/core/test_startup.py`` checks it.
 
 Every verb runs its work inside :func:`handled`, which turns an exception into one line on
 stderr and the exit status of :mod:`roughbrdf.cli` (2 usage or input, 3 operating system, 4 a

@@ -4,7 +4,7 @@ Left: the incidence (degrees), the model's options (drop-downs of the values the
 accepts) and one slider with a typed field per parameter (its search bounds as the slider's
 ends, its unit, its domain in the tooltip), the fit and export panels. Right: the views in tabs
 (3-D lobe, cuts, hemisphere maps, albedo, Mueller, compare). Element ids are the contract of
-the callbacks and of ``tests/test_explore_browser.py``.
+the callbacks and of ``tests/explore/test_explore_browser.py``.
 """
 
 from __future__ import annotations

@@ -18,7 +18,7 @@ into the ``--out`` folder), so it answers only the browser tab its user opened:
   request), must be the server's own origin: a foreign one is **403**.
 
 The guard is WSGI middleware (:class:`Guard`) around the Dash (Flask) application; it needs no
-Dash and is tested on its own (``tests/test_explore_server.py``).
+Dash and is tested on its own (``tests/explore/test_explore_server.py``).
 
 Examples
 --------

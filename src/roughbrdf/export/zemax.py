@@ -18,7 +18,7 @@ The default grid:
 How good the table is, is measured by its own integral
 (:func:`roughbrdf.io.zemax.table_integral`) against TIS. With the default grid the difference
 stays below 1.3e-3 (absolute) at every incidence for the Lambertian, coated, microfacet GGX
-(alpha 0.05 and 0.3), Oren-Nayar, TS67 and TR75 models (``tests/test_export_zemax.py``). What
+(alpha 0.05 and 0.3), Oren-Nayar, TS67 and TR75 models (``tests/export/test_export_zemax.py``). What
 limits it is the grid: a lobe narrower than the radial spacing (the radial angles are shared by
 all incidences, so the spacing follows the narrowest lobe), the horizon, which cuts the lobe
 between nodes at grazing incidence (the largest errors are at 80 deg), and the azimuth step

@@ -48,7 +48,7 @@ __all__ = ["AUTO_LOSS", "FitOptions", "MODEL_LOSSES", "check_loss", "check_polar
 #: keeps it -- TR75 (held-out peak ratio 0.07 against 3.2, held-out r.m.s. ln 0.61 against
 #: 0.50; C2_Black's ``e`` on its search limit), microfacet (held-out peak ratio 0.36, down to
 #: 0.001 on the glossy black, against 0.63), TS67 (C2_Black 465 nm: TR75's sigma 15 against
-#: 0.4, the peak dropped; ``tests/test_fitting_real.py``); a sum with one of them as well
+#: 0.4, the peak dropped; ``tests/fitting/test_fitting_real.py``); a sum with one of them as well
 MODEL_LOSSES: dict[str, str] = {"trowbridge-reitz-1975": "relative",
                                 "torrance-sparrow-1967": "relative", "microfacet": "relative"}
 #: the loss of ``loss="auto"`` for every other model (and sums)

@@ -13,9 +13,10 @@ and statistics").
   multiplicative plus an additive floor, so in a ratio or log loss the dim samples scatter far
   more than the peak that fixes the lobe's width and weight; the classical form then inflates
   those parameters' errors (1-sigma intervals covered the truth in 85-95 % of synthetic
-  two-lobe fits instead of 68 %; the sandwich: 60-80 %, ``tests/test_fit_coverage.py``). Where
-  the residuals are homoscedastic the two agree. ``stderr = sqrt(diag(covar))``, ``correl`` is
-  ``covar`` normalized. A singular ``J^T J`` gives NaN and a note for the message; joint fits
+  two-lobe fits instead of 68 %; the sandwich: 60-80 %,
+  ``tests/fitting/test_fit_coverage.py``). Where the residuals are homoscedastic the two agree.
+  ``stderr = sqrt(diag(covar))``, ``correl`` is ``covar`` normalized. A singular ``J^T J``
+  gives NaN and a note for the message; joint fits
   (:mod:`~roughbrdf.fitting.joint`) keep the classical form;
 * :func:`at_bound` -- the parameters at (or within :data:`AT_BOUND_RTOL` of the width of their
   bounds from) a bound. They get no standard error: the covariance describes the cost as a

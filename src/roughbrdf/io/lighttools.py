@@ -23,7 +23,7 @@ Layout (``#`` begins a comment, to the end of its line)::
 Source: libbsdf (K. Ryo, MPL-2.0, https://github.com/KimuraRyo/libbsdf,
 ``src/Reader/LightToolsBsdfReader.cpp`` and ``reader_utility::classifyFile``, commit
 ``eb62dc164b6c6d6b107f720aef17dc0b6b2eda23``); no public description by Synopsys was found.
-What libbsdf's reader expects, and this module follows (``tests/test_io_lighttools.py`` pins
+What libbsdf's reader expects, and this module follows (``tests/io/test_io_lighttools.py`` pins
 each point):
 
 * header keywords ``Symmetry`` (``PlaneSymmetrical`` or ``Asymmetric`` - libbsdf refuses

@@ -398,7 +398,7 @@ class Coated(Model):
     @property
     def conserves_energy(self) -> bool:
         """True with the default ``weights="partition"`` (``docs/models.md`` §10.4;
-        ``tests/test_coated_energy.py`` checks albedo <= 1 + 1e-3 over the whole domain)."""
+        ``tests/models/test_coated_energy.py`` checks albedo <= 1 + 1e-3 over the whole domain)."""
         return self._options.get("weights") != "free"
 
     def lobe_mirror(self) -> tuple[tuple[tuple[str, str], ...], tuple[str, ...]] | None:

@@ -10,7 +10,7 @@ Cook & Torrance (1982) / Walter et al. (2007) form, built from :mod:`roughbrdf.d
 reflectance of a part, ``roughbrdf.models.parameters``), but its search range is the physical
 ``[0, 1]``: one interface with ``F <= 1`` reflects at most what it receives (the albedo at
 ``ks = 1`` is at most 1 + 1e-12 for every distribution with Smith or V-groove shadowing,
-``alpha`` 0.01-2, ``F = 1`` included; ``tests/test_coated_energy.py``). Without shadowing
+``alpha`` 0.01-2, ``F = 1`` included; ``tests/models/test_coated_energy.py``). Without shadowing
 (``shadowing="none"``) it diverges at grazing incidence whatever ``ks``. A fit may be given a
 wider range (``bounds={"ks": (0, 20)}``); its report and ``fit.json`` then say it used a
 non-physical range (:mod:`roughbrdf.fitting.physical`). With data of unknown scale (a free

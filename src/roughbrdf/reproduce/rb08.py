@@ -34,7 +34,7 @@ __all__ = ["CEA_GRAY_TAPE", "CEA_GRAY_TAPE_OPTIONS", "PLAUSIBLE", "PARAMS", "OPT
 #: ``belcour/alta`` repository, ``documents/data/``, commit 7c54015c, see ../shared/data/README.md),
 #: with the model option :data:`CEA_GRAY_TAPE_OPTIONS` (``retro_shadowing="amplitude"``: the
 #: retro V pair scales the retro lobe's amplitude instead of narrowing its width). Fitted on
-#: 2026-11-22 with the recipe of ``tests/test_fitting_real.py::
+#: 2026-11-22 with the recipe of ``tests/fitting/test_fitting_real.py::
 #: test_rb08_amplitude_reading_reproduces_retro_peaks_on_all_samples``::
 #:
 #:     meas = rb.read("retro-gray-tape.dat", quantity="brdf_cos")

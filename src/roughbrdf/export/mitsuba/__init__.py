@@ -9,7 +9,7 @@ variants never see the polarization of TR75 Eq. 24.
 
 Mappings (Mitsuba's ``eval()`` returns ``f_r cos(theta_o)``; "exact" means the same formula,
 checked with Mitsuba itself to 1e-4 relative at random geometries in
-``tests/test_export_mitsuba.py``; Mitsuba's float32 arithmetic limits the agreement to a few
+``tests/export/test_export_mitsuba.py``; Mitsuba's float32 arithmetic limits the agreement to a few
 1e-6, 3e-5 next to the critical angle of a dielectric with ``n < 1``)
 
 ================================  ==========================================================

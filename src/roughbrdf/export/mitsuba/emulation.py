@@ -5,7 +5,7 @@ deviation is measured against :func:`mitsuba_values`, which reproduces the ``eva
 plugins this package writes -- ``diffuse``, ``roughconductor`` (its Smith ``G1``, the rational
 approximation for Beckmann, and its ``D cos theta_h <= 1e-20 -> 0`` cut-off),
 ``roughplastic`` (its internal-reflection tables, :func:`roughbrdf.diffuse.rough_interface`
-with ``g1="mitsuba"``) and ``blendbsdf`` -- and ``tests/test_export_mitsuba.py`` checks it
+with ``g1="mitsuba"``) and ``blendbsdf`` -- and ``tests/export/test_export_mitsuba.py`` checks it
 against Mitsuba itself (to 1e-4 relative; Mitsuba's float32 arithmetic accounts for a few
 1e-6).
 """
@@ -112,7 +112,7 @@ def mitsuba_values(bsdf: dict[str, Any], theta_i: Any, theta_r: Any, phi: Any) -
 
     A transcription of the ``diffuse``, ``roughconductor``, ``roughplastic`` and
     ``blendbsdf`` plugins' ``eval`` (their Beckmann ``G1``, cut-off and tables included), used
-    for the deviations every export reports; ``tests/test_export_mitsuba.py`` checks it
+    for the deviations every export reports; ``tests/export/test_export_mitsuba.py`` checks it
     against Mitsuba. Angles in radians (the library's frame); ``theta_i, theta_r < pi/2``.
 
     Returns

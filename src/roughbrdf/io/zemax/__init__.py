@@ -30,7 +30,7 @@ S. Auriol; https://support.zemax.com/hc/en-us/articles/1500005486801) and its 20
 "How to use tabular BSDF data to define the surface scattering distribution"
 (https://support.zemax.com/hc/en-us/articles/1500005576362).
 
-Conventions (each pinned by a test in ``tests/test_io_zemax.py``):
+Conventions (each pinned by a test in ``tests/io/test_io_zemax.py``):
 
 * **AngleOfIncidence** is, in Zemax's words, "a misnomer: this angle actually represents the
   specular reflected or transmitted angle". For a BRDF the specular angle equals the angle of

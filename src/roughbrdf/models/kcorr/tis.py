@@ -24,7 +24,7 @@ slowest near grazing incidence, where ``cos theta_r`` has a branch point at ``rh
 sin theta_i)`` just behind the start: measured for ``0.5 <= B/lambda <= 500``,
 ``0.5 <= C <= 6``, the defaults (128 x 192) agree with a 512 x 1024 rule to 5e-6 relative up
 to ``theta_i = 89°`` (3e-7 up to 60°), and with :func:`roughbrdf.albedo` to 1e-4 relative,
-the tested bound, up to ``theta_i = 80°`` (tests/test_straylight_kcorr.py).
+the tested bound, up to ``theta_i = 80°`` (tests/models/test_straylight_kcorr.py).
 
 Small-roughness closed form (:func:`tis_smooth_limit`)
 ------------------------------------------------------

@@ -32,7 +32,7 @@ adaptive cubature handles that slowly and without a guarantee)
 
 Accuracy: checked against the exact normal-incidence forms (``2π G(1)``, closed form for both
 models), the constant ABg (``g = 0``: ``π A/(B+1)`` at every incidence), the plane forms below
-and :func:`roughbrdf.albedo` (tests/test_straylight_abg_hs.py states the ranges).
+and :func:`roughbrdf.albedo` (tests/models/test_straylight_abg_hs.py states the ranges).
 
 Plane closed forms (the unit disk replaced by the whole plane, an upper bound of the TIS,
 reached when the lobe is far from the rim)::

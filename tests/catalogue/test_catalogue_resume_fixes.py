@@ -1,6 +1,6 @@
-"""``roughbrdf fit-batch``: the fixes of issue 26, item 5 (catalogue part).
+"""``roughbrdf fit-batch``: safe names, honest exit statuses and a clean ``--resume``.
 
-Each test names the observation of the issue it answers:
+Each test names the fault it keeps fixed:
 
 * a file name with Markdown link syntax became a live link in ``summary.md``;
 * ``--resume`` counted ``skipped (resume)`` rows as success, kept the old paths of moved
@@ -85,7 +85,7 @@ def _rendered(folder: Path, names: list[str]) -> str:
 
 
 def test_summary_markdown_makes_no_markup_of_names(tmp_path):
-    # the issue: `[x](javascript:alert(9)).astm` was a live link in summary.md; rendered by a
+    # the fault: `[x](javascript:alert(9)).astm` was a live link in summary.md; rendered by a
     # real CommonMark renderer (markdown-it-py, installed with rich), the page has exactly the
     # elements it has with plain names: no name becomes a link, an image, emphasis, code, HTML
     # or a block; and each is shown exactly as it is
@@ -123,7 +123,7 @@ def test_names_with_control_characters_are_quoted():
 
 
 def test_failure_of_a_name_with_a_newline_is_one_line(cluster, tmp_path):
-    # the issue: an input name with a newline split its failure message over two lines
+    # the fault: an input name with a newline split its failure message over two lines
     data = tmp_path / "in"
     data.mkdir()
     _write(data / "good.csv", rho=0.3)
@@ -145,7 +145,7 @@ def test_failure_of_a_name_with_a_newline_is_one_line(cluster, tmp_path):
 # --------------------------------------------------------------------------------------------
 
 def test_kept_rows_count_as_their_earlier_status():
-    # the issue: the exit status counted `skipped (resume)` rows as success
+    # the fault: the exit status counted `skipped (resume)` rows as success
     kept = {"status": "skipped (resume)"}
     assert CatalogueResult([{**kept, "earlier_status": "ok"}], Path(".")).success
     for earlier in ("gains-energy", "not converged", "at-search-limit", None):
@@ -171,7 +171,7 @@ def test_resume_exit_status_is_the_earlier_one(cluster, tmp_path):
 
 
 def test_resume_names_moved_inputs_where_they_are(cluster, tmp_path):
-    # the issue: --resume after the inputs moved (same bytes) kept rows naming the old paths
+    # the fault: --resume after the inputs moved (same bytes) kept rows naming the old paths
     old, new = tmp_path / "old", tmp_path / "new"
     old.mkdir()
     for k in range(2):
@@ -191,7 +191,7 @@ def test_resume_names_moved_inputs_where_they_are(cluster, tmp_path):
 
 @pytest.mark.parametrize("again", [["--resume"], ["--force"]])
 def test_own_outputs_are_never_inputs(cluster, tmp_path, again):
-    # the issue: `fit-batch IN --out IN` then --resume fitted catalogue.csv, catalogue.json,
+    # the fault: `fit-batch IN --out IN` then --resume fitted catalogue.csv, catalogue.json,
     # summary.html and summary.md as inputs (failed rows); with --force as well
     data = tmp_path / "in"
     data.mkdir()
@@ -228,7 +228,7 @@ def _stall_mid_write(task):
 
 
 def test_time_limit_restart_leaves_no_lock_or_temporary_file(cluster, tmp_path, monkeypatch):
-    # the issue: workers restarted by --time-limit mid-write left 12 `.roughbrdf-lock` /
+    # the fault: workers restarted by --time-limit mid-write left 12 `.roughbrdf-lock` /
     # `.roughbrdf-tmp-` files behind; the folder is recovered at the end of the run
     import cloudpickle
 
@@ -263,7 +263,7 @@ def test_time_limit_restart_leaves_no_lock_or_temporary_file(cluster, tmp_path, 
     ("--loss", "nope", "--loss: unknown value 'nope'"),
 ])
 def test_option_errors_name_the_option(tmp_path, verb, option, value, expected):
-    # the issue: `--seed -1` said "expected non-negative integer" naming no option (numpy's
+    # the fault: `--seed -1` said "expected non-negative integer" naming no option (numpy's
     # words); options.check_search words it for every verb that fits, before any work
     src = _write(tmp_path / "a.csv", rho=0.3)
     model = ["--models", "lambertian,tr75"] if verb == "compare" else ["-m", "lambertian"]

@@ -1,4 +1,5 @@
-"""The stray-light models at the command line (issue 21): fit, per incidence, export, list.
+"""The stray-light models (ABg, Harvey-Shack, K-correlation) at the command line: fit, per
+incidence, export, list.
 
 Files: the committed Zemax examples (``tests/data/zemax/``: AnoBlack NiTE on Invar, 650 nm, and
 Aeroglaze Z307, incidences 10-70 deg). Expected values: TIS <= 1 at every incidence (the energy

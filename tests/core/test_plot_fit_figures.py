@@ -1,4 +1,4 @@
-"""Figures that show a fit honestly (issue "Fits a user can trust", item 6).
+"""Figures that show a fit honestly: a user can trust what they see.
 
 * the residual map has one panel per measured incidence, one colour scale and one colour bar;
 * the comparison's value axis holds the model's peak as well as the data;
@@ -80,7 +80,7 @@ def test_comparison_y_range_holds_the_model_peak():
     for ln in models:
         x, y = np.asarray(ln.get_xdata()), np.asarray(ln.get_ydata())
         peak = np.max(y[(x >= -80) & (x <= 80)])
-        assert peak > 3 * np.max(meas.values)  # the case of the issue: off the old axis
+        assert peak > 3 * np.max(meas.values)  # a model peak the old axis (data only) cut off
         assert lo < peak < hi, ln.get_label()
     assert hi > np.max(meas.values)
 
@@ -118,7 +118,7 @@ def test_plot_fit_draws_the_fits_own_samples(minidiff_fit, tmp_path, monkeypatch
     assert "warning" not in err.lower()
     fit = json.loads((minidiff_fit / "fit.json").read_text())
     n_points = fit["channels"][0]["metrics"]["n_points"]
-    assert fit["channels"][0]["excluded"]["extrapolated"] > 0  # the case of the issue
+    assert fit["channels"][0]["excluded"]["extrapolated"] > 0  # the Mini-Diff ramp left out
 
     fig, _ax = drawn["plot_residual_map"]
     panels = _scatter_axes(fig)

@@ -1,4 +1,4 @@
-"""The Zemax ABg catalog table (``export/abg_catalog.py``, issue 21).
+"""The Zemax ABg catalog table (``export/abg_catalog.py``): per-incidence ABg rows and TIS.
 
 The expected values are the model's own parameters and its TIS by ``rb.albedo`` (an ABg model
 with ``g = 0`` is the constant ``A/(B + 1)``, whose TIS is ``pi A/(B + 1)`` at every incidence).

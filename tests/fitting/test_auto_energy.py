@@ -1,4 +1,4 @@
-"""``--model auto`` on the three shared paints keeps its physics (issue 20's first must-show).
+"""``--model auto`` on the three shared paints keeps its physics: no kept model gains energy.
 
 Before the energy-conserving coated model and the energy constraint, ``rb.fit("auto")`` on
 ``C2_Black.astm`` kept two Beckmann lobes with ``ks = 20`` whose albedo was 4.0-4.5 at 80 deg

@@ -288,7 +288,7 @@ def _candidate(label: str, cv: float | None, bic: float, albedo: float = 0.5):
 def test_rank_by_score_bic_beside_energy_gain_last():
     from roughbrdf.fitting.compare import ModelComparison, rank
 
-    # the case: the lowest BIC predicts the left-out incidences worst
+    # the case that made the score rank: the lowest BIC predicts the left-out incidences worst
     rows = [_candidate("a", 1.36, -900.0), _candidate("b", 0.52, -500.0),
             _candidate("c", 0.40, -950.0, albedo=4.0), _candidate("d", 0.77, -600.0)]
     ranked, criterion = rank(rows)

@@ -3,7 +3,7 @@
 Expected values come from closed forms (an equality-constrained linear least-squares problem
 solved with its Lagrange multiplier) and from another solver (SciPy's SLSQP on the same
 quadratic program); the refit's convergence from synthetic TR75 sets whose penalty refit used
-to stop on its evaluation budget (issue 20).
+to stop on its evaluation budget.
 """
 
 from __future__ import annotations

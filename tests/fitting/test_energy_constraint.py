@@ -1,7 +1,8 @@
-"""Issue 20 item 1: models that cannot guarantee ``albedo <= 1`` (TR75 with ``rho_L``, RB08, sums
-of models) are fitted under the explicit constraint ``albedo(theta_i) <= 1`` at 0, 5, ... 85,
-89 deg: the accurate :func:`roughbrdf.albedo` of the result is at most ``1 + 1e-3`` there.
-``energy_constraint=False`` (``--no-energy-constraint``) gives the unconstrained fit."""
+"""Fits that conserve energy: models that cannot guarantee ``albedo <= 1`` (TR75 with
+``rho_L``, RB08, sums of models) are fitted under the explicit constraint
+``albedo(theta_i) <= 1`` at 0, 5, ... 85, 89 deg: the accurate :func:`roughbrdf.albedo` of
+the result is at most ``1 + 1e-3`` there. ``energy_constraint=False``
+(``--no-energy-constraint``) gives the unconstrained fit."""
 
 from __future__ import annotations
 

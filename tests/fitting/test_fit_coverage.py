@@ -5,8 +5,8 @@ gonioreflectometer-like grid (incidences 0-60 deg, theta_r 0-80 deg, phi 0-180 d
 noise of such an instrument: multiplicative log-normal 5 %, plus an additive Gaussian floor of
 1e-3 of the peak (``docs/fitting.md``, "Choosing the loss"). Over 20 seeds, for every parameter,
 the 1-sigma interval ``value +/- stderr`` must cover the truth for 68 +/- 15 % of the seeds and
-the 2-sigma interval for at least 85 % (the issue's criterion; a binomial 20-seed count of a
-true 68 % falls in 53-83 % with probability about 0.87, and the seeds are fixed).
+the 2-sigma interval for at least 85 % (the criterion of honest errors; a binomial 20-seed count of
+a true 68 % falls in 53-83 % with probability about 0.87, and the seeds are fixed).
 
 The classical ``(J^T J)^-1 chi2/dof`` fails this: it covered alpha, alpha2 and w2 for 85-100 %
 of the seeds (the additive floor makes the dim samples' ratio residuals scatter more than the

@@ -33,7 +33,7 @@ def files(tmp_path_factory):
 
 
 #: the relative loss: with rho = 0 exactly, the robust (default) fit of these noise-free data
-#: stops at rho ~ 1e-5 short of its edge (a convergence limit noted on issue 20); what is
+#: stops at rho ~ 1e-5 short of its edge (a known convergence limit of that loss); what is
 #: tested here is how an edge and a search limit are told apart
 LOSS = ["--loss", "relative"]
 

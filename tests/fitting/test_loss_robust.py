@@ -1,4 +1,4 @@
-"""The robust loss (issue 20, item 2): soft-L1 on log residuals, from the user's side.
+"""The robust loss: soft-L1 on log residuals, from the user's side.
 
 ``rb.fit(..., loss="robust")`` minimizes ``sum(w² 2c² (sqrt(1 + r²/c²) - 1))`` with ``r`` the
 log residual and ``c = 0.1`` (``docs/fitting.md``, "What is minimized" and "Choosing the loss");

@@ -1,4 +1,4 @@
-"""Fits per incidence and the rows a catalog keeps (``fitting/per_incidence.py``, issue 21).
+"""Fits per incidence and the rows a catalog keeps (``fitting/per_incidence.py``).
 
 Expected values: a Lambertian truth whose ``rho`` is linear in ``cos theta_i`` (then Zemax's
 interpolation rule, linear in cosine, is exact between any two rows) or piecewise constant (then

@@ -1,4 +1,4 @@
-"""Zemax and LightTools files share ``.bsdf``: ``rb.read`` tells them apart by content (issue 21).
+"""Zemax and LightTools files share ``.bsdf``: ``rb.read`` tells them apart by content.
 
 The files: the committed Zemax examples (``tests/data/zemax/``, LOFT bsdf-tools) and the
 LightTools files of ``tests/data/lighttools/`` (pinned by libbsdf's reader, see its README).

@@ -1,4 +1,4 @@
-"""The coated model conserves energy by construction (issue 20, item 1; docs/models.md §10.3).
+"""The coated model conserves energy by construction (docs/models.md §10.3).
 
 Its lobes are roughness scales of one interface: their weights sum to 1 (one lobe: weight 1;
 ``w2``, ``w3`` share it out), and the substrate receives only what the interface transmits

@@ -242,8 +242,8 @@ def write(measurement: Measurement, path: str | os.PathLike, format: str | None 
         in anything but CSV).
     """
     fmt = format_for(path, format)
-    if fmt == "lighttools":  # its writer lives with the model writer (no import cycle)
-        from ..export.lighttools import write_measurement
+    if fmt == "lighttools":  # its writer is a module of its own (the reader is long enough)
+        from .lighttools_write import write_measurement
 
         return write_measurement(measurement, path, overwrite=overwrite, **options)
     mod = _module(fmt)

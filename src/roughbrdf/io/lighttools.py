@@ -56,9 +56,9 @@ where the values agree.
 Reading (:func:`read`): one channel per wavelength (``"550nm"``; ``"value"`` when the blocks
 give none) or per tristimulus value (``"X"``, ``"Y"``, ``"Z"``); the front side's BRDF blocks
 by default (``side="back"`` for the other); BTDF blocks and the other side are left out and
-counted in ``meta["lighttools_ignored"]``. Writing: :mod:`roughbrdf.export.lighttools`
-(``format_table``, the text; ``to_lighttools``, a model on a grid; ``write_measurement``,
-a measurement on a LightTools grid).
+counted in ``meta["lighttools_ignored"]``. Writing: :mod:`roughbrdf.io.lighttools_write`
+(``format_table``, the text; ``write_measurement``, a measurement on a LightTools grid) and
+:mod:`roughbrdf.export.lighttools` (``to_lighttools``, a model on a grid).
 """
 
 from __future__ import annotations

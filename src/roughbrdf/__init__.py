@@ -126,13 +126,26 @@ class _ExplorePackage(_types.ModuleType):
         return inspect.signature(explore)
 
 
+def _load_renderings() -> None:
+    """Register the notebook HTML of models and measurements (:mod:`roughbrdf.html_repr`)."""
+    import importlib
+
+    importlib.import_module(f"{__name__}.html_repr")
+
+
 class _Package(_types.ModuleType):
     """This package's module type: binds the subpackage ``explore`` callable
-    (:class:`_ExplorePackage`)."""
+    (:class:`_ExplorePackage`), and gives :mod:`roughbrdf.rich_display` the loader of the
+    notebook renderings when it is bound (imported): the models and the measurement, low in
+    the layers, display through it without importing :mod:`roughbrdf.html_repr`, which is
+    higher (it shows fit results); the face names every layer, so the hook lives here and
+    ``import roughbrdf`` still loads nothing."""
 
     def __setattr__(self, name: str, value: object) -> None:
         if name == "explore" and type(value) is _types.ModuleType:
             value.__class__ = _ExplorePackage
+        elif name == "rich_display" and isinstance(value, _types.ModuleType):
+            value.set_loader(_load_renderings)
         super().__setattr__(name, value)
 
 

@@ -4,7 +4,9 @@ Jupyter shows an object by its ``_repr_html_`` when it has one (IPython's rich d
 protocol, "Rich output" in the IPython documentation: a method returning an HTML fragment).
 :meth:`Model._repr_html_ <roughbrdf.models.Model._repr_html_>`,
 :meth:`Measurement._repr_html_ <roughbrdf.measurement.Measurement._repr_html_>` and
-:meth:`FitResult._repr_html_ <roughbrdf.fitting.FitResult._repr_html_>` call the builders here:
+:meth:`FitResult._repr_html_ <roughbrdf.fitting.FitResult._repr_html_>` use the builders here
+(the first two through :mod:`roughbrdf.rich_display`, with which this module registers them
+when imported: they are lower in the package's layers and do not import this module):
 
 * :func:`model_html`: the model's name and reference, a table of its parameters (value, unit,
   search bounds, physical domain, description) and its options; a sum, one block per component;
@@ -31,6 +33,8 @@ from html import escape
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from .rich_display import register_html
 
 if TYPE_CHECKING:
     from .fitting.result import ChannelFit, FitResult
@@ -203,3 +207,8 @@ def fit_html(res: FitResult) -> str:
         facts.append(("aperture half-angle, deg", number(math.degrees(res.aperture), 4)))
     return _block("Fit", _facts(facts),
                   *(_channel_html(res, i) for i in range(len(res.channels))))
+
+
+# the low objects display through the registry (see the module docstring)
+register_html("model", model_html)
+register_html("measurement", measurement_html)

@@ -210,10 +210,11 @@ class Measurement:
                 f"{self.channels}, {self.quantity}, file={self.meta.get('file')!r}>")
 
     def _repr_html_(self) -> str:
-        """Jupyter's rich display (:func:`roughbrdf.html_repr.measurement_html`)."""
-        from .html_repr import measurement_html
+        """Jupyter's rich display (:func:`roughbrdf.html_repr.measurement_html`, registered
+        from above: :mod:`roughbrdf.rich_display`)."""
+        from .rich_display import html
 
-        return measurement_html(self)
+        return html("measurement", self)
 
     # ------------------------------------------------------------------------------------------
     # size and provenance

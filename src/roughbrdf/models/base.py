@@ -434,10 +434,11 @@ class Model:
 
     def _repr_html_(self) -> str:
         """Jupyter's rich display: name, reference, parameters, options
-        (:func:`roughbrdf.html_repr.model_html`; a sum, one block per component)."""
-        from ..html_repr import model_html
+        (:func:`roughbrdf.html_repr.model_html`, registered from above:
+        :mod:`roughbrdf.rich_display`; a sum, one block per component)."""
+        from ..rich_display import html
 
-        return model_html(self)
+        return html("model", self)
 
 
 def require_index(model: Model) -> None:

@@ -41,20 +41,15 @@ __all__ = ["app", "main", "build_app", "get_app", "VERBS", "EXIT_OK", "EXIT_NOT_
            "EXIT_USAGE", "EXIT_OS", "EXIT_BUG", "EXIT_INTERRUPTED", "interrupted_status",
            "interrupt_line"]
 
-EXIT_OK = 0
-EXIT_NOT_CONVERGED = 1
-EXIT_USAGE = 2
-EXIT_OS = 3
-EXIT_BUG = 4
-EXIT_INTERRUPTED = 130  # 128 + SIGINT; SIGTERM and SIGHUP give 143 and 129
-
-
-def interrupted_status() -> int:
-    """The exit status of a run that a signal interrupted: 128 + its number (130 for Ctrl-C,
-    143 for SIGTERM, 129 for SIGHUP: :func:`roughbrdf.interrupts.interrupt_signal`)."""
-    from ..interrupts import interrupt_signal
-
-    return 128 + interrupt_signal()
+# the statuses (the table above) and interrupted_status are defined with the one-line wording
+# of errors that the explorer shares (roughbrdf.wording, a lower layer); re-exported here
+from ..wording import EXIT_BUG as EXIT_BUG
+from ..wording import EXIT_INTERRUPTED as EXIT_INTERRUPTED
+from ..wording import EXIT_NOT_CONVERGED as EXIT_NOT_CONVERGED
+from ..wording import EXIT_OK as EXIT_OK
+from ..wording import EXIT_OS as EXIT_OS
+from ..wording import EXIT_USAGE as EXIT_USAGE
+from ..wording import interrupted_status as interrupted_status
 
 
 def interrupt_line() -> str:

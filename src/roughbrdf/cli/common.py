@@ -29,13 +29,24 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from . import EXIT_BUG, EXIT_OS, EXIT_USAGE, Run, interrupt_line, interrupted_status
+# the wording of errors and the degrees of model settings are shared with the explorer (a lower
+# layer), so they live in roughbrdf.wording; re-exported here under their names
+from ..wording import ANGLE_UNIT as ANGLE_UNIT
+from ..wording import EXIT_OS, interrupted_status, model_in_degrees, radian_settings
+from ..wording import angle_names as angle_names
+from ..wording import argument_text as argument_text
+from ..wording import cli_number as cli_number
+from ..wording import cli_text as cli_text
+from ..wording import cli_unit as cli_unit
+from ..wording import error_message as error_message
+from ..wording import exit_status as exit_status
+from ..wording import shown_name as shown_name
+from . import Run, interrupt_line
 from .options import OptionError, naming
 
 if TYPE_CHECKING:
     import numpy as np
 
-    from ..errors import ArgumentError
     from ..measurement import Measurement
     from ..models import Model
 
@@ -139,135 +150,6 @@ def _silence_stdout() -> None:
         pass
 
 
-def exit_status(exc: BaseException) -> int:
-    """The exit status for ``exc`` (see :mod:`roughbrdf.cli`).
-
-    Examples
-    --------
-    >>> exit_status(ValueError("bad option")), exit_status(PermissionError(13, "denied"))
-    (2, 3)
-    """
-    from ..output import OverwriteRefused
-
-    if isinstance(exc, KeyboardInterrupt):  # 130, or 128 + the SIGTERM/SIGHUP that raised it
-        return interrupted_status()
-    if isinstance(exc, OverwriteRefused | FileNotFoundError | ValueError | TypeError):
-        return EXIT_USAGE
-    if isinstance(exc, OSError | MemoryError):
-        return EXIT_OS
-    return EXIT_BUG
-
-
-def error_message(exc: BaseException, options: Mapping[str, str] | None = None,
-                  code: int | None = None) -> str:
-    """One line for ``exc``: library argument errors name CLI options; OS errors name the path
-    and the cause; anything unexpected says it is a bug."""
-    from ..errors import ArgumentError
-    from ..output import OverwriteRefused
-
-    opts = {"overwrite": "--force", **(options or {})}
-    if isinstance(exc, ArgumentError):
-        return cli_text(argument_text(exc, opts), opts)
-    if isinstance(exc, OverwriteRefused):
-        return exc.render(opts)
-    if isinstance(exc, OSError) and exc.strerror:
-        where = None if exc.filename is None else shown_name(exc.filename)
-        if exc.filename2 is not None:
-            where = f"{where} -> {shown_name(exc.filename2)}"
-        return f"{where}: {exc.strerror}" if where is not None else exc.strerror
-    if isinstance(exc, MemoryError):
-        return f"out of memory{': ' + str(exc) if str(exc) else ''}"
-    text = " ".join(str(exc).split()) or type(exc).__name__
-    if not text.isprintable():  # a control character (an escape) left: shown escaped
-        from ..catalogue.rows import one_line
-
-        text = one_line(text)
-    if (exit_status(exc) if code is None else code) == EXIT_BUG:
-        return (f"internal error: {type(exc).__name__}: {text} (a bug in roughbrdf; "
-                f"`roughbrdf --debug ...` shows the traceback)")
-    return cli_text(text, opts)
-
-
-def shown_name(name: object) -> str:
-    r"""A file name as one-line messages show it (:func:`roughbrdf.catalogue.rows.shown_name`:
-    as it is, or quoted like a Python string when it holds a newline, a tab or another
-    character that is not printable); the catalogue, which imports the models, is loaded
-    only for such a name.
-
-    Examples
-    --------
-    >>> print(shown_name("a b.csv"), shown_name("two\nlines.csv"))
-    a b.csv 'two\nlines.csv'
-    """
-    text = str(name)
-    if text.isprintable():  # the common case, without importing the catalogue
-        return text
-    from ..catalogue.rows import shown_name as quoted
-
-    return quoted(text)
-
-
-def argument_text(exc: ArgumentError, options: Mapping[str, str]) -> str:
-    """``exc`` rendered with the verb's ``options``, always naming the option.
-
-    A check worded in Python terms without the value (``"starts must be >= 1"``) names the
-    option in place of the argument (``"--starts must be >= 1"``), or ahead of the message.
-
-    Examples
-    --------
-    >>> from roughbrdf.errors import ArgumentError
-    >>> argument_text(ArgumentError("starts", "starts must be >= 1, got 0"), {"starts": "--starts"})
-    '--starts must be >= 1, got 0'
-    >>> argument_text(ArgumentError("loss", "unknown loss 'x'"), {"loss": "--loss"})
-    "--loss: unknown loss 'x'"
-    """
-    text = " ".join(exc.render(options).split())
-    opt = options.get(exc.argument)
-    if opt is None or opt in text:  # not an option of this verb, or already named
-        return text
-    for sep in (" ", ":"):
-        if text.startswith(exc.argument + sep):
-            return opt + text[len(exc.argument):]
-    return f"{opt}: {text}"
-
-
-#: a value after ``name=`` in a library message: quoted, or a bare word
-_HINT_VALUE = r"(?:'[^']*'|\"[^\"]*\"|[\w.+-]+)"
-
-
-def cli_text(text: str, options: Mapping[str, str] | None) -> str:
-    """A library message with its Python argument hints worded as this verb's options.
-
-    The readers and the fit speak Python (``pass format=``, ``angles='deg'``), sometimes with a
-    CLI hint for one verb (``(CLI: --from/--to)``); each ``name=`` of an argument in
-    ``options`` becomes that option, hint included.
-
-    Examples
-    --------
-    >>> cli_text("unknown extension; pass format= (CLI: --from/--to)", FIT_OPTIONS)
-    'unknown extension; pass --format'
-    >>> cli_text("the angles look like degrees (angles='deg'; CLI: --angles-in deg)",
-    ...          FIT_OPTIONS)
-    'the angles look like degrees (--angles-in deg)'
-    >>> cli_text("exists (pass overwrite=True; CLI: --force)", CONVERT_OPTIONS)
-    'exists (pass --force)'
-    """
-    import re
-
-    for arg, opt in (options or {}).items():
-        if not arg.isidentifier() or f"{arg}=" not in text:  # fast path: nothing to word
-            continue
-        pattern = (rf"\b{re.escape(arg)}=({_HINT_VALUE})?"
-                   r"(?:;\s*CLI:\s*[^);]*|\s*\((?:CLI:\s*)?--[^)]*\))?")
-
-        def word(m: re.Match[str], opt: str = opt) -> str:
-            value = (m.group(1) or "").strip("'\"")
-            return opt if value in ("", "True") else f"{opt} {value}"
-
-        text = re.sub(pattern, word, text)
-    return text
-
-
 def parse_params(items: list[str] | None) -> dict[str, float | None | str]:
     """``["e=0.5", "n=None", "distribution=ggx"]`` -> dict (numbers where they parse)."""
     out: dict[str, float | None | str] = {}
@@ -329,37 +211,12 @@ def degree_range(text: str, name: str) -> np.ndarray:
     return np.radians(start + step * np.arange(count))
 
 
-# --------------------------------------------------------------------------------------------
-# model parameters whose unit is an angle: degrees at the CLI, radians in the library
-# --------------------------------------------------------------------------------------------
-#: the unit of a model parameter (:attr:`roughbrdf.models.Parameter.unit`) that is an angle;
-#: the CLI takes and prints such parameters in degrees. Units *per* angle (TS67 ``c`` in
-#: ``1/deg``, RB08's ``1/rad`` coefficients) are rates, not angles: they are left as they are.
-ANGLE_UNIT = "rad"
-
-
-def cli_unit(unit: str) -> str:
-    """The unit a CLI shows for a parameter of ``unit`` (``"rad"`` -> ``"deg"``)."""
-    return "deg" if unit == ANGLE_UNIT else unit
-
-
-def cli_number(unit: str, value: float | None) -> float | None:
-    """``value`` of a parameter of ``unit`` as the CLI shows it (radians -> degrees)."""
-    if value is None or unit != ANGLE_UNIT:
-        return value
-    return math.degrees(value)
-
-
-def angle_names(model: Model) -> set[str]:
-    """The parameters of ``model`` (prefixed in sums) whose unit is an angle."""
-    return {p.name for p in model.parameters if p.unit == ANGLE_UNIT}
-
-
 def cli_model(spec: str, params: Mapping[str, object] | None = None,
               option: str | None = None) -> Model:
     """``roughbrdf.model(spec, **params)`` with ``-p`` settings as the CLI gives them: a
     parameter whose unit is an angle (Oren-Nayar ``sigma``, also in ``coated(diffuse=
-    "oren-nayar")`` and in sums, by plain or prefixed name) in degrees.
+    "oren-nayar")`` and in sums, by plain or prefixed name) in degrees
+    (:func:`roughbrdf.wording.model_in_degrees`).
 
     With ``option`` (how the verb takes the spec: ``"--model"``, ``"MODEL"``) an error names
     what is wrong: the spec (``option``) or a ``-p`` setting (``-p/--param``)
@@ -376,28 +233,16 @@ def cli_model(spec: str, params: Mapping[str, object] | None = None,
     """
     from .. import models as _models
 
+    if option is None:
+        return model_in_degrees(spec, params)
     given = dict(params or {})
     try:
         first = _models.model(spec, **given)  # names and units (angles in degrees pass the
     except ValueError as exc:  # sign checks of their domains just as well)
-        if option is None:
-            raise
         raise _model_error(spec, option, exc, bool(given)) from exc
-    angles = angle_names(first)
-    if not angles:
+    converted = radian_settings(first, given)
+    if converted is None:
         return first
-    converted = dict(given)
-    for key, value in given.items():
-        if not isinstance(value, float):
-            continue
-        try:
-            (name,) = _models.resolve_names(first, [key])
-        except ValueError:  # an option (diffuse=...), not a parameter
-            continue
-        if name in angles:
-            converted[key] = math.radians(value)
-    if option is None:
-        return _models.model(spec, **converted)
     with naming("-p/--param"):  # an angle's value outside its domain
         return _models.model(spec, **converted)
 

@@ -44,7 +44,7 @@ def _say(text: str) -> None:
 
 
 def _message(exc: BaseException) -> str:
-    from ..cli.common import error_message
+    from ..wording import error_message
 
     return error_message(exc)
 

@@ -103,7 +103,7 @@ class FitJob:
     def _run(self) -> None:
         import roughbrdf as rb
 
-        from ..cli.common import error_message
+        from ..wording import error_message
 
         try:
             for label in self.channels:

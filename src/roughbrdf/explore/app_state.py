@@ -5,7 +5,7 @@ A :class:`Session` holds a measurement (``FILE``), a model (``--model SPEC -p ..
 fit's models (``--fit DIR``), any of them absent, and the one error that stopped loading
 (shown in the terminal and on the page, never a traceback). Angles are radians here as in the
 library; the page shows parameters whose unit is an angle in degrees, as the command line does
-(:func:`roughbrdf.cli.common.cli_unit`). Nothing here imports Dash.
+(:func:`roughbrdf.wording.cli_unit`). Nothing here imports Dash.
 """
 
 from __future__ import annotations
@@ -97,7 +97,7 @@ def load_session(file: str | None = None, *, fit_dir: str | None = None,
                  model: str | None = None, params: dict[str, Any] | None = None,
                  out: str | None = None, format: str | None = None) -> Session:
     """Load the inputs of a run; an error becomes :attr:`Session.error` (one line, the
-    command line's wording: :func:`roughbrdf.cli.common.error_message`).
+    command line's wording: :func:`roughbrdf.wording.error_message`).
 
     Examples
     --------
@@ -109,7 +109,7 @@ def load_session(file: str | None = None, *, fit_dir: str | None = None,
     """
     import roughbrdf as rb
 
-    from ..cli.common import cli_model, error_message
+    from ..wording import error_message, model_in_degrees
 
     session = Session(out=Path(out).resolve() if out else None)
     labels = [f"fit {fit_dir}"] * (fit_dir is not None) + [str(file)] * (file is not None) \
@@ -122,7 +122,7 @@ def load_session(file: str | None = None, *, fit_dir: str | None = None,
         if file is not None:
             session.measurement = rb.read(file, format=format)
         if model is not None:
-            session.model = cli_model(model, params)
+            session.model = model_in_degrees(model, params)
     except Exception as exc:  # noqa: BLE001 - every failure is the page's one message
         session.error = error_message(exc, CLI_OPTIONS)
     return session

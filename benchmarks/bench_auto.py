@@ -23,7 +23,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import roughbrdf as rb
-from roughbrdf.fitting.auto import fit_auto
+from roughbrdf.fitting.choice.auto import fit_auto
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # run.py loads by path
 from machine import cpu_name, load, vector_width  # noqa: E402

@@ -52,7 +52,7 @@ from scipy.stats import qmc
 
 import roughbrdf as rb
 from roughbrdf import geometry
-from roughbrdf.fitting.threads import single_thread_blas
+from roughbrdf.fitting.solvers.threads import single_thread_blas
 
 HERE = Path(__file__).resolve().parent
 DATA = Path(os.environ.get("ROUGHBRDF_SHARED_DATA", HERE.parent.parent / "shared" / "data"))

@@ -3,7 +3,7 @@
 Needs ``../shared/data`` (or ``ROUGHBRDF_SHARED_DATA``); prints a note and returns without it.
 
 1. **Table per paint and model.** Each candidate of ``--model auto``
-   (:data:`roughbrdf.fitting.compare.AUTO_CANDIDATES`) and two more (three lobes; two lobes
+   (:data:`roughbrdf.fitting.choice.compare.AUTO_CANDIDATES`) and two more (three lobes; two lobes
    over an Oren-Nayar substrate), fitted with ``rb.fit`` defaults (relative loss, every
    measured sample: theta_r > 75 deg is the instrument's extrapolation and left out,
    :mod:`roughbrdf.extrapolation`), and the joint fit of the chosen model: sigma and rms-log per
@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 import roughbrdf as rb
-from roughbrdf.fitting.compare import AUTO_CANDIDATES, information
+from roughbrdf.fitting.choice.compare import AUTO_CANDIDATES, information
 
 HERE = Path(__file__).resolve().parent
 DATA = Path(os.environ.get("ROUGHBRDF_SHARED_DATA", HERE.parent.parent / "shared" / "data"))
@@ -45,7 +45,7 @@ def _metrics_all_samples(res) -> tuple[list[float], list[float]]:
     for c in res.channels:
         x = m.values[:, m.channel_index(c.channel)]
         f = res.predict(m.theta_i, m.theta_r, m.phi, channel=c.channel)
-        fs = np.maximum(f, 1e-12 * np.max(np.abs(x)))  # the fit's floor (fitting.objective)
+        fs = np.maximum(f, 1e-12 * np.max(np.abs(x)))  # the fit's floor (fitting.problem.objective)
         sig.append(float(np.sqrt(np.mean((x / fs - 1.0) ** 2))))
         pos = (x > 0) & (f > 0)
         rl.append(float(np.sqrt(np.mean(np.log(x[pos] / f[pos]) ** 2))))

@@ -1,4 +1,4 @@
-"""The margin of ``--model auto``'s skip (``roughbrdf.fitting.auto.SKIP_MARGIN``), measured.
+"""The margin of ``--model auto``'s skip (``roughbrdf.fitting.choice.auto.SKIP_MARGIN``), measured.
 
 For each shared paint: every default candidate compared on the whole file (``rb.compare``, the
 choice without any skip), each candidate's score on the first channel alone and its ratio to
@@ -20,9 +20,9 @@ import warnings
 from pathlib import Path
 
 import roughbrdf as rb
-from roughbrdf.fitting.auto import SKIP_MARGIN
-from roughbrdf.fitting.compare import AUTO_CANDIDATES, cross_validate, score_metric
-from roughbrdf.fitting.options import FitOptions
+from roughbrdf.fitting.choice.auto import SKIP_MARGIN
+from roughbrdf.fitting.choice.compare import AUTO_CANDIDATES, cross_validate, score_metric
+from roughbrdf.fitting.problem.options import FitOptions
 from roughbrdf.models import from_spec, spec_text
 
 LABELS = [spec_text(from_spec(c)) for c in AUTO_CANDIDATES]

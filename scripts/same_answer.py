@@ -4,7 +4,7 @@ The compiled kernels round differently with another vector width (AVX-512, AVX2)
 library picks its kernels by processor too. A fit's outcome must not depend on it
 (``docs/fitting.md``, "The same answer on every machine"). This script runs, in a fresh
 process per variant, ``rb.compare`` of every ``--model auto`` candidate
-(``roughbrdf.fitting.compare.AUTO_CANDIDATES``, with its cross-validation score, i.e. what
+(``roughbrdf.fitting.choice.compare.AUTO_CANDIDATES``, with its cross-validation score, i.e. what
 ``--model auto`` decides on) on each of the three shared Mini-Diff paints, under
 
 ``host``
@@ -61,7 +61,7 @@ CHILD = r"""
 import json, math, sys, warnings
 import numpy as np
 import roughbrdf as rb
-from roughbrdf.fitting.compare import AUTO_CANDIDATES
+from roughbrdf.fitting.choice.compare import AUTO_CANDIDATES
 data, paints, perturb = sys.argv[1], sys.argv[2].split(","), float(sys.argv[3])
 out = {}
 for paint in paints:

@@ -2,7 +2,7 @@
 
 A change that promises "no behaviour change" (a restructuring of the code) must give the same
 fits. This script checks out two commits into temporary worktrees, fits every candidate of
-``--model auto`` (``roughbrdf.fitting.compare.AUTO_CANDIDATES``, ``rb.fit`` defaults) to each
+``--model auto`` (``roughbrdf.fitting.AUTO_CANDIDATES``, ``rb.fit`` defaults) to each
 channel of the three shared Mini-Diff paints with each commit's own code, in a fresh process
 per commit, and compares every fitted parameter::
 
@@ -34,7 +34,7 @@ PAINTS = ("C2_Black", "C8_Silver", "C12_OliveDrab")
 CHILD = r"""
 import json, sys
 import roughbrdf as rb
-from roughbrdf.fitting.compare import AUTO_CANDIDATES
+from roughbrdf.fitting import AUTO_CANDIDATES
 data, paints = sys.argv[1], sys.argv[2].split(",")
 out = {}
 for paint in paints:

@@ -4,7 +4,7 @@ committed Zemax examples and to a shared Mini-Diff paint.
 ``.venv/bin/python scripts/straylight_figures.py [--out docs/img]`` (about a minute). For each
 file: ABg and Harvey-Shack fitted with ``rb.fit`` defaults (one parameter set for all
 incidences; the energy constraint keeps TIS <= 1), and ABg per incidence
-(:func:`roughbrdf.fitting.per_incidence.fit_per_incidence`); prints a Markdown table (the
+(:func:`roughbrdf.fitting.kinds.per_incidence.fit_per_incidence`); prints a Markdown table (the
 parameters, rms-log, the largest TIS over 0-89 deg) and draws the in-plane cuts (data points and
 model lines per measured incidence, log scale) into ``straylight_<file>.png``. The Mini-Diff
 paints need ``../shared/data`` (or ``ROUGHBRDF_SHARED_DATA``); without it that file is skipped
@@ -22,8 +22,8 @@ from pathlib import Path
 import numpy as np
 
 import roughbrdf as rb
-from roughbrdf.fitting.per_incidence import fit_per_incidence
-from roughbrdf.fitting.plausibility import EXPORT_INCIDENCES_DEG
+from roughbrdf.fitting.kinds.per_incidence import fit_per_incidence
+from roughbrdf.fitting.results.plausibility import EXPORT_INCIDENCES_DEG
 
 HERE = Path(__file__).resolve().parent
 SHARED = Path(os.environ.get("ROUGHBRDF_SHARED_DATA", HERE.parent.parent / "shared" / "data"))

@@ -6,7 +6,8 @@
   private *modules* of the package (``_kernels``, ``io/_common``) are fine;
 * no import cycle among modules at run time, counting imports inside functions and not those
   under ``if TYPE_CHECKING:``;
-* the fit options declared in exactly one place (:class:`roughbrdf.fitting.options.FitOptions`):
+* the fit options declared in exactly one place
+  (:class:`roughbrdf.fitting.problem.options.FitOptions`):
   no other function spells out their list as its own parameters.
 """
 
@@ -171,15 +172,15 @@ def test_the_cycle_finder_finds_cycles():
 
 
 def _fit_option_names() -> set[str]:
-    path = PACKAGE / "fitting" / "options.py"
+    path = PACKAGE / "fitting" / "problem" / "options.py"
     if not path.exists():
-        pytest.fail("roughbrdf/fitting/options.py (the one FitOptions) does not exist")
+        pytest.fail("roughbrdf/fitting/problem/options.py (the one FitOptions) does not exist")
     tree = ast.parse(path.read_text(encoding="utf-8"))
     for node in ast.walk(tree):
         if isinstance(node, ast.ClassDef) and node.name == "FitOptions":
             return {s.target.id for s in node.body
                     if isinstance(s, ast.AnnAssign) and isinstance(s.target, ast.Name)}
-    pytest.fail("no class FitOptions in roughbrdf/fitting/options.py")
+    pytest.fail("no class FitOptions in roughbrdf/fitting/problem/options.py")
 
 
 def test_fit_options_declared_in_one_place():

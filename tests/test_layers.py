@@ -49,6 +49,20 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("cli", ("cli", "demo")),
 )
 
+#: the inner rooms of ``roughbrdf.fitting``, lowest first (``roughbrdf/fitting/__init__.py``
+#: lists what each holds): a room imports only the rooms before it (the package face,
+#: ``roughbrdf.fitting`` itself, re-exports and is exempt)
+FITTING_ROOMS: tuple[tuple[str, tuple[str, ...]], ...] = (
+    ("problem", ("fitting.problem",)),
+    ("solvers", ("fitting.solvers",)),
+    ("results", ("fitting.results",)),
+    ("energy", ("fitting.energy",)),
+    ("kinds", ("fitting.kinds",)),
+    ("choice", ("fitting.choice",)),
+    ("load", ("fitting.load",)),
+    ("fit", ("fitting.fit",)),
+)
+
 
 # --------------------------------------------------------------------------------------------
 # the checker (pure functions of parsed source, tested on synthetic modules below)
@@ -188,6 +202,13 @@ def test_every_room_names_a_module():
 def test_imports_point_down():
     bad = upward_imports(TREES, PACKAGES, FACE)
     assert not bad, "upward imports:\n" + "\n".join(bad)
+
+
+def test_the_fitting_rooms_point_down():
+    inner = {m: t for m, t in TREES.items() if m.startswith(f"{TOP}.fitting.")}
+    assert not unplaced(inner, FITTING_ROOMS), unplaced(inner, FITTING_ROOMS)
+    bad = upward_imports(inner, PACKAGES, FACE, FITTING_ROOMS)
+    assert not bad, "upward imports between the rooms of fitting:\n" + "\n".join(bad)
 
 
 # --------------------------------------------------------------------------------------------

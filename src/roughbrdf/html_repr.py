@@ -37,7 +37,7 @@ import numpy as np
 from .rich_display import register_html
 
 if TYPE_CHECKING:
-    from .fitting.result import ChannelFit, FitResult
+    from .fitting.results.result import ChannelFit, FitResult
     from .measurement import Measurement
     from .models import Model
 

@@ -3,10 +3,12 @@
 :func:`plot_fit` draws :func:`roughbrdf.plot.plot_comparison` (in-plane slices, the full width
 above) and :func:`roughbrdf.plot.plot_residual_map` (one map per incidence below) into one
 figure, with a note under it saying which samples the fit left out and why (the counts of
-:attr:`roughbrdf.fitting.data.ChannelData.excluded` in words,
-:func:`roughbrdf.fitting.data.excluded_text`). The measurement given is drawn as it is: give it
+:attr:`roughbrdf.fitting.problem.data.ChannelData.excluded` in words,
+:func:`roughbrdf.fitting.problem.data.excluded_text`). The measurement given is drawn as it is:
+give it
 the samples the fit used (:meth:`FitResult.plot_data <roughbrdf.fitting.FitResult.plot_data>`,
-or ``roughbrdf plot --fit``'s selection through :func:`roughbrdf.fitting.data.prepare_channel`),
+or ``roughbrdf plot --fit``'s selection through
+:func:`roughbrdf.fitting.problem.data.prepare_channel`),
 so that the figure shows the fit and nothing else. Matplotlib is imported when a figure is
 drawn, not with this module.
 """

@@ -1,7 +1,8 @@
 """Reading a results folder: one whole set, or a refusal saying why and what to do.
 
 A results folder (:class:`roughbrdf.output.ResultFolder`: ``roughbrdf fit ... --out DIR``,
-:meth:`FitResult.save <roughbrdf.fitting.result.FitResult.save>`) is written as one set, through
+:meth:`FitResult.save <roughbrdf.fitting.results.result.FitResult.save>`) is written as one set,
+through
 the commit journal of :mod:`roughbrdf.journal`. A write cut off by a kill leaves the journal
 beside a mix of old and new files until the next run into the folder repairs it. Every read
 of such a folder (:func:`roughbrdf.load_fit`; ``--fit DIR`` of ``roughbrdf plot``, ``export``

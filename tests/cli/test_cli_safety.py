@@ -388,7 +388,7 @@ def test_debug_shows_the_traceback(tmp_path):
 
 
 def test_exit_status_1_when_a_fit_does_not_converge(tmp_path, monkeypatch):
-    from roughbrdf.fitting.result import FitResult
+    from roughbrdf.fitting.results.result import FitResult
 
     monkeypatch.setattr(FitResult, "success", property(lambda self: False))
     res = _cli(*FIT[:-1], "1", "--no-plots", "-q", "--out", tmp_path / "o")

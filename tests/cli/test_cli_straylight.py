@@ -19,8 +19,8 @@ from typer.testing import CliRunner
 
 import roughbrdf as rb
 from roughbrdf.cli import app
-from roughbrdf.fitting.compare import AUTO_CANDIDATES
-from roughbrdf.fitting.plausibility import EXPORT_INCIDENCES_DEG
+from roughbrdf.fitting.choice.compare import AUTO_CANDIDATES
+from roughbrdf.fitting.results.plausibility import EXPORT_INCIDENCES_DEG
 
 DATA = Path(__file__).parents[1] / "data" / "zemax"
 ANOBLACK = DATA / "AnoBlackNiTEonINVAR.bsdf"

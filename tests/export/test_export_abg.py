@@ -15,7 +15,7 @@ import roughbrdf as rb
 import roughbrdf.models.straylight  # noqa: F401 - registers abg
 from roughbrdf.errors import ArgumentError
 from roughbrdf.export.abg_catalog import MAX_ROWS, write_abg_catalog
-from roughbrdf.fitting.per_incidence import fit_per_incidence
+from roughbrdf.fitting.kinds.per_incidence import fit_per_incidence
 from roughbrdf.output import OverwriteRefused
 
 

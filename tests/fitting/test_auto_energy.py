@@ -6,7 +6,7 @@ and 8.8-9.9 at 85 deg. Now no candidate's fitted model, on any channel, has an a
 ``1 + 1e-3`` at any incidence of the export grid (0, 5, ... 85, 89 deg; ``rb.albedo``, the
 accurate quadrature), and the kept one is the best by the leave-one-incidence-out score. The
 same holds for the two other shared paints (C8_Silver, C12_OliveDrab), and every fit has
-converged (the energy refit's constrained finish, ``fitting/constrained.py``).
+converged (the energy refit's constrained finish, ``fitting/solvers/constrained.py``).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import roughbrdf as rb
-from roughbrdf.fitting.plausibility import EXPORT_INCIDENCES_DEG
+from roughbrdf.fitting.results.plausibility import EXPORT_INCIDENCES_DEG
 
 
 @pytest.mark.slow

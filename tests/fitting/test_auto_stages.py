@@ -1,4 +1,4 @@
-"""``--model auto`` in two stages (``roughbrdf.fitting.auto``): a candidate far behind on the
+"""``--model auto`` in two stages (``roughbrdf.fitting.choice.auto``): a candidate far behind on the
 first channel is skipped, and the candidates fitted further get the fit ``rb.compare`` makes.
 
 What is protected: the choice and every kept candidate's fit are those of the whole comparison
@@ -15,11 +15,11 @@ import numpy as np
 import pytest
 
 import roughbrdf as rb
-import roughbrdf.fitting.auto  # noqa: F401  (the module, not the function of the same name)
-from roughbrdf.fitting.channels import fit_model
-from roughbrdf.fitting.options import FitOptions
+import roughbrdf.fitting.choice.auto  # noqa: F401  (the module, not the function of the same name)
+from roughbrdf.fitting.kinds.channels import fit_model
+from roughbrdf.fitting.problem.options import FitOptions
 
-auto = sys.modules["roughbrdf.fitting.auto"]
+auto = sys.modules["roughbrdf.fitting.choice.auto"]
 
 TRUTH = rb.model("coated", n=1.5, rho=0.3, alpha=0.15)
 CANDIDATES = ["lambertian", "coated", "coated(lobes=2)"]

@@ -1,4 +1,5 @@
-"""The bounded Levenberg-Marquardt of the polish (``fitting/bounded.py``) and the polish rounds
+"""The bounded Levenberg-Marquardt of the polish (``fitting/solvers/bounded.py``) and the polish
+rounds
 (``fitting/search.polish_fit``); docs/fitting.md, "Polish".
 
 Expected values come from the Karush-Kuhn-Tucker conditions of a bounded least-squares problem,
@@ -14,7 +15,7 @@ import pytest
 
 import roughbrdf as rb
 from roughbrdf.fitting import search
-from roughbrdf.fitting.bounded import LAMBDA_MAX, BoundedResult, bounded_lm, bounded_step
+from roughbrdf.fitting.solvers.bounded import LAMBDA_MAX, BoundedResult, bounded_lm, bounded_step
 
 
 class Residuals:

@@ -1,5 +1,5 @@
 """Model choice: ``rb.compare``, ``rb.fit("auto", ...)`` and model specs
-(:mod:`roughbrdf.fitting.compare`, :mod:`roughbrdf.models.factory`).
+(:mod:`roughbrdf.fitting.choice.compare`, :mod:`roughbrdf.models.factory`).
 
 Where the expected numbers come from:
 
@@ -25,7 +25,7 @@ import pytest
 
 import roughbrdf as rb
 from roughbrdf.errors import ArgumentError
-from roughbrdf.fitting.compare import (
+from roughbrdf.fitting.choice.compare import (
     AUTO_CANDIDATES,
     THETA_R_BANDS,
     band_rms_log,
@@ -277,7 +277,7 @@ def _candidate(label: str, cv: float | None, bic: float, albedo: float = 0.5):
     ranking reads only the score, the BIC and the albedo."""
     from types import SimpleNamespace
 
-    from roughbrdf.fitting.compare import Candidate
+    from roughbrdf.fitting.choice.compare import Candidate
 
     plaus = SimpleNamespace(max_albedo=albedo)
     chan = SimpleNamespace(channel="c", model=rb.model("lambertian"), free=["rho"], params={})
@@ -286,7 +286,7 @@ def _candidate(label: str, cv: float | None, bic: float, albedo: float = 0.5):
 
 
 def test_rank_by_score_bic_beside_energy_gain_last():
-    from roughbrdf.fitting.compare import ModelComparison, rank
+    from roughbrdf.fitting.choice.compare import ModelComparison, rank
 
     # the case that made the score rank: the lowest BIC predicts the left-out incidences worst
     rows = [_candidate("a", 1.36, -900.0), _candidate("b", 0.52, -500.0),
@@ -296,7 +296,7 @@ def test_rank_by_score_bic_beside_energy_gain_last():
     assert [c.label for c in ranked] == ["b", "d", "a", "c"]  # c gains energy: last
     cmp = ModelComparison(ranked, None, criterion=criterion)  # type: ignore[arg-type]
     assert cmp.best.label == "b" and cmp.best_bic.label == "c" and cmp.best_cv.label == "c"
-    from roughbrdf.fitting.compare import choice_notes
+    from roughbrdf.fitting.choice.compare import choice_notes
 
     notes = choice_notes(cmp)
     assert any("ranked by cross-validation: b" in n and "BIC prefers c" in n for n in notes)
@@ -313,7 +313,7 @@ def test_rank_by_score_bic_beside_energy_gain_last():
 def test_a_lobe_below_1e_3_is_switched_off_and_not_counted(w2, off):
     # a second lobe of weight 0 (w2 = 0) or a first lobe of weight 0 (w2 = 1), w2 held there:
     # the idle lobe's width is fitted but shapes nothing -- k counts one unknown less
-    from roughbrdf.fitting.compare import lobes_off
+    from roughbrdf.fitting.choice.compare import lobes_off
 
     meas = _measurement()
     res = rb.fit(rb.model("coated", lobes=2, w2=w2), meas, fix=["w2"], starts=1,

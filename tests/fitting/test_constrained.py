@@ -1,4 +1,4 @@
-"""The constrained Levenberg–Marquardt of the energy refit (``fitting/constrained.py``).
+"""The constrained Levenberg–Marquardt of the energy refit (``fitting/solvers/constrained.py``).
 
 Expected values come from closed forms (an equality-constrained linear least-squares problem
 solved with its Lagrange multiplier) and from another solver (SciPy's SLSQP on the same
@@ -15,9 +15,13 @@ import pytest
 from scipy.optimize import minimize
 
 import roughbrdf as rb
-from roughbrdf.fitting.bounded import GaussNewtonModel
-from roughbrdf.fitting.constrained import Limits, constrained_lm, finite_limits, lsi_step
-from roughbrdf.fitting.plausibility import ENERGY_TOLERANCE, EXPORT_INCIDENCES_DEG, EnergyWarning
+from roughbrdf.fitting.results.plausibility import (
+    ENERGY_TOLERANCE,
+    EXPORT_INCIDENCES_DEG,
+    EnergyWarning,
+)
+from roughbrdf.fitting.solvers.bounded import GaussNewtonModel
+from roughbrdf.fitting.solvers.constrained import Limits, constrained_lm, finite_limits, lsi_step
 
 THETA = np.radians(EXPORT_INCIDENCES_DEG)
 #: the convergence test of tol = 1e-12 bounds the predicted cost decrease by tol * cost: the

@@ -19,7 +19,11 @@ from roughbrdf.cli import app, main
 from roughbrdf.errors import ArgumentError
 from roughbrdf.fitting import FitOptions
 from roughbrdf.fitting.energy import FAST_ALBEDO_ACCURACY, fast_albedo
-from roughbrdf.fitting.plausibility import ENERGY_TOLERANCE, EXPORT_INCIDENCES_DEG, EnergyWarning
+from roughbrdf.fitting.results.plausibility import (
+    ENERGY_TOLERANCE,
+    EXPORT_INCIDENCES_DEG,
+    EnergyWarning,
+)
 from roughbrdf.models import model_label
 
 GRID = np.radians(np.mgrid[0:61:20, 0:81:5, 0:181:30].reshape(3, -1))

@@ -10,7 +10,7 @@ a true 68 % falls in 53-83 % with probability about 0.87, and the seeds are fixe
 
 The classical ``(J^T J)^-1 chi2/dof`` fails this: it covered alpha, alpha2 and w2 for 85-100 %
 of the seeds (the additive floor makes the dim samples' ratio residuals scatter more than the
-peak's); :class:`~roughbrdf.fitting.statistics.Covariance` is the sandwich form.
+peak's); :class:`~roughbrdf.fitting.results.statistics.Covariance` is the sandwich form.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import roughbrdf as rb
-from roughbrdf.fitting.statistics import Covariance
+from roughbrdf.fitting.results.statistics import Covariance
 
 TRUTH = rb.model("coated", lobes=2, n=1.5, rho=0.3, alpha=0.08, alpha2=0.3, w2=0.3)
 SEEDS = range(20)

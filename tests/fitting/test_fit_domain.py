@@ -14,7 +14,7 @@ import roughbrdf as rb
 from roughbrdf.cli import app
 from roughbrdf.demo import default_measurement_path
 from roughbrdf.errors import ArgumentError
-from roughbrdf.fitting.data import outside_fit_domain
+from roughbrdf.fitting.problem.data import outside_fit_domain
 from roughbrdf.measurement import Measurement
 
 MODEL = rb.model("trowbridge-reitz-1975", e=0.4, rho_L=0.05)

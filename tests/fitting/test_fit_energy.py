@@ -15,7 +15,7 @@ import pytest
 import roughbrdf as rb
 from roughbrdf.cli import main
 from roughbrdf.errors import ArgumentError
-from roughbrdf.fitting.plausibility import ALBEDO_INCIDENCES_DEG, EnergyWarning
+from roughbrdf.fitting.results.plausibility import ALBEDO_INCIDENCES_DEG, EnergyWarning
 from roughbrdf.journal import MANIFEST
 
 GRID = np.radians(np.mgrid[0:61:30, 0:81:10, 0:181:45].reshape(3, -1))

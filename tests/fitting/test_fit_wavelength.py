@@ -1,4 +1,5 @@
-"""A fit gives a wavelength-dependent model each channel's wavelength (``fitting/wavelengths.py``).
+"""A fit gives a wavelength-dependent model each channel's wavelength
+(``fitting/problem/wavelengths.py``).
 
 The K-correlation (Rayleigh–Rice) BRDF scales as ``lambda^-4`` times the PSD at
 ``|beta - beta0|/lambda`` (``docs/straylight.md``): data of two channels at 465 and 630 nm from
@@ -13,7 +14,11 @@ import pytest
 
 import roughbrdf as rb
 from roughbrdf.errors import ArgumentError
-from roughbrdf.fitting.wavelengths import channel_wavelength, needs_wavelength, with_wavelength
+from roughbrdf.fitting.problem.wavelengths import (
+    channel_wavelength,
+    needs_wavelength,
+    with_wavelength,
+)
 
 TRUTH = {"A": 2e-5, "B": 8.0, "C": 3.0}
 

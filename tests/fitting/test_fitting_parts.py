@@ -14,11 +14,11 @@ import pytest
 
 import roughbrdf as rb
 from roughbrdf.fitting import ChannelData, Objective, ObjectiveSpec
-from roughbrdf.fitting.data import Comparison, excluded_text
-from roughbrdf.fitting.plan import FreeParameters
-from roughbrdf.fitting.search import MultiStart, SearchOptions, screen, sobol_points
-from roughbrdf.fitting.statistics import Covariance, GoodnessOfFit
-from roughbrdf.fitting.threads import single_thread_blas
+from roughbrdf.fitting.problem.data import Comparison, excluded_text
+from roughbrdf.fitting.problem.plan import FreeParameters
+from roughbrdf.fitting.results.statistics import Covariance, GoodnessOfFit
+from roughbrdf.fitting.solvers.search import MultiStart, SearchOptions, screen, sobol_points
+from roughbrdf.fitting.solvers.threads import single_thread_blas
 from roughbrdf.measurement import Measurement
 from roughbrdf.quantity import relative_scale
 

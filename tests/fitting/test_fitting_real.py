@@ -180,7 +180,7 @@ def test_rb08_amplitude_reading_reproduces_retro_peaks_on_all_samples(shared_dat
     # energy_constraint=False: the recipe's figures were measured unconstrained; under the
     # constraint (RB08's albedo <= 1 at every incidence) the gray tape's 60 deg retro peak
     # came out 1.7x the measured one with the penalty refit (not re-measured since the
-    # constrained finish, fitting/constrained.py)
+    # constrained finish, fitting/solvers/constrained.py)
     res = rb.fit(rb.model("renhorn-boreman-2008", retro_shadowing="amplitude"), meas,
                  loss="log", weights=w, bounds={"n_eff": (1.0, 5.0)}, starts=8, seed=0,
                  progress=False, energy_constraint=False)

@@ -1,5 +1,5 @@
 """Joint fits across channels: ``fit(..., joint=True, shared=...)``
-(:mod:`roughbrdf.fitting.joint`).
+(:mod:`roughbrdf.fitting.kinds.joint`).
 
 Where the expected numbers come from:
 
@@ -27,7 +27,7 @@ import pytest
 
 import roughbrdf as rb
 from roughbrdf.errors import ArgumentError
-from roughbrdf.fitting.compare import information
+from roughbrdf.fitting.choice.compare import information
 
 SHARED_TRUE = {"n": 1.5, "alpha": 0.15}
 RHO_TRUE = {"b": 0.1, "g": 0.3, "r": 0.6}

@@ -185,7 +185,7 @@ def test_fewer_samples_than_recorded_warn(saved, tmp_path):
 
 
 def test_per_incidence_fit_is_refused_with_what_to_do(tmp_path):
-    from roughbrdf.fitting.per_incidence import fit_per_incidence
+    from roughbrdf.fitting.kinds.per_incidence import fit_per_incidence
 
     meas = rb.read(DATA)
     fit_per_incidence("lambertian", meas, starts=1, progress=False).save(tmp_path)

@@ -1,4 +1,4 @@
-"""Fits per incidence and the rows a catalog keeps (``fitting/per_incidence.py``).
+"""Fits per incidence and the rows a catalog keeps (``fitting/kinds/per_incidence.py``).
 
 Expected values: a Lambertian truth whose ``rho`` is linear in ``cos theta_i`` (then Zemax's
 interpolation rule, linear in cosine, is exact between any two rows) or piecewise constant (then
@@ -14,7 +14,7 @@ import pytest
 
 import roughbrdf as rb
 from roughbrdf.errors import ArgumentError
-from roughbrdf.fitting.per_incidence import MAX_ROWS, fit_per_incidence, interpolate_params
+from roughbrdf.fitting.kinds.per_incidence import MAX_ROWS, fit_per_incidence, interpolate_params
 
 
 def _measurement(rho_of_theta, incidences_deg):

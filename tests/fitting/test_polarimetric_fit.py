@@ -18,7 +18,7 @@ import pytest
 
 import roughbrdf as rb
 from roughbrdf.errors import ArgumentError
-from roughbrdf.fitting.polarimetric import MuellerFitResult
+from roughbrdf.fitting.kinds.polarimetric import MuellerFitResult
 from roughbrdf.io import FormatError
 from roughbrdf.measurement import MUELLER_ELEMENTS, Measurement
 

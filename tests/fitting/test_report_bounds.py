@@ -21,8 +21,8 @@ import numpy as np
 import pytest
 
 import roughbrdf as rb
-from roughbrdf.fitting.report import MAX_PERCENT_RATIO, percent
-from roughbrdf.fitting.statistics import AT_BOUND_RTOL, at_bound
+from roughbrdf.fitting.results.report import MAX_PERCENT_RATIO, percent
+from roughbrdf.fitting.results.statistics import AT_BOUND_RTOL, at_bound
 from roughbrdf.measurement import Measurement
 
 TS67_TRUE = {"g": 2.0, "c": 0.08, "rho_d": 0.3}
@@ -143,7 +143,7 @@ def test_starts_counted_as_asked_on_every_channel(starts):
 
 
 def test_progress_bar_total_matches_the_local_fits(monkeypatch):
-    import roughbrdf.fitting.channels as fitting
+    import roughbrdf.fitting.kinds.channels as fitting
 
     seen = {}
 

@@ -5,7 +5,8 @@ by about 1e-13 of a value. These tests make that difference on any machine -- th
 multiplied by ``1 + 1e-13 z`` -- and require the same outcome: ``success``, the parameters on a
 bound and which, the parameters the data determine within 0.1 of their standard error
 (``docs/fitting.md``, "The same answer on every machine"). Before the first-order test, the
-flat parameters and the settling on bounds (``fitting/stationary.py``), 3 of 6 such copies of
+flat parameters and the settling on bounds (``fitting/solvers/stationary.py``), 3 of 6 such copies
+of
 C8_Silver's TR75 fit at 630 nm ended with "no step lowers the cost", and 3 of 8 of the synthetic
 TR75 fit below on their budget or with ``e`` on a search limit. ``make test-avx2`` runs this file
 (and every fit of the shared paints) again with kernels compiled for an AVX2 processor.

@@ -37,7 +37,7 @@ from .rows import outcome
 from .tasks import Task
 
 if TYPE_CHECKING:
-    from ..fitting.options import FitOptions
+    from ..fitting.problem.options import FitOptions
 
 __all__ = ["fit_catalogue", "CatalogueResult", "expand_inputs", "folder_names",
            "check_options", "CATALOGUE_FILES", "RESERVED"]
@@ -210,7 +210,7 @@ def fit_catalogue(inputs: str | os.PathLike | Iterable[str | os.PathLike], model
     read_options : mapping, optional
         Passed to :func:`roughbrdf.read` (``format``, ``quantity``, ``angles``).
     candidates, cv
-        With ``model="auto"``: as for :func:`roughbrdf.fitting.auto.fit_auto`.
+        With ``model="auto"``: as for :func:`roughbrdf.fitting.choice.auto.fit_auto`.
     time_limit : float, optional
         Seconds one task may run; a task over it is reported failed and its worker restarted.
     retries : int
@@ -300,7 +300,8 @@ def check_options(model: Any, fit_options: Mapping[str, Any] | None = None, *,
     (:class:`~roughbrdf.errors.ArgumentError` naming the argument), instead of failing each
     file on the workers: unknown keywords of :func:`roughbrdf.fit`, the checks of
     :class:`roughbrdf.fitting.FitOptions` (loss, starts, seed, subsample, aperture, fit
-    domain ...) and those of :class:`roughbrdf.fitting.plan.FitPlan` (fix, bounds) on a small
+    domain ...) and those of :class:`roughbrdf.fitting.problem.plan.FitPlan` (fix, bounds) on a
+    small
     stand-in measurement, without fitting. Options whose validity depends on the file (a
     channel label, ``quantity=`` against what the file says) are left to the task.
 
@@ -313,7 +314,7 @@ def check_options(model: Any, fit_options: Mapping[str, Any] | None = None, *,
     """
     import dataclasses
 
-    from ..fitting.options import FitOptions
+    from ..fitting.problem.options import FitOptions
 
     _check_run_options(time_limit, retries, n_workers)
     if read_options:
@@ -334,11 +335,11 @@ def check_options(model: Any, fit_options: Mapping[str, Any] | None = None, *,
 
 
 def _check_plan(model: Any, opts: FitOptions) -> None:
-    """:class:`~roughbrdf.fitting.plan.FitPlan`'s checks of ``opts`` on a stand-in
+    """:class:`~roughbrdf.fitting.problem.plan.FitPlan`'s checks of ``opts`` on a stand-in
     measurement (a few directions; relative data when ``relative_to`` is given)."""
     import numpy as np
 
-    from ..fitting.plan import FitPlan
+    from ..fitting.problem.plan import FitPlan
     from ..measurement import Measurement
     from ..quantity import Quantity
 

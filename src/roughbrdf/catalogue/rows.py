@@ -64,7 +64,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from ..fitting.result import FitResult
+    from ..fitting.results.result import FitResult
 
 __all__ = ["BY_INCIDENCE", "COLUMNS", "STATUSES", "SKIPPED", "failed_row", "fit_rows",
            "csv_text", "json_text", "status_of", "outcome", "shown_name", "one_line"]

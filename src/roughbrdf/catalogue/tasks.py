@@ -19,7 +19,7 @@ from .resume import TASK_FILE, file_sha256
 from .rows import failed_row, fit_rows, one_line
 
 if TYPE_CHECKING:
-    from ..fitting.options import FitOptions
+    from ..fitting.problem.options import FitOptions
 
 __all__ = ["Task", "run_task"]
 
@@ -82,7 +82,7 @@ def _fit_and_save(task: Task, sha: str | None, t0: float) -> list[dict[str, Any]
 
     from .. import io as _io
     from ..fitting import FitOptions, fit
-    from ..fitting.auto import fit_auto
+    from ..fitting.choice.auto import fit_auto
     from ..output import ResultFolder
 
     meas = _io.read(task.path, **task.read_options)

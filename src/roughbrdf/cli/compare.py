@@ -20,7 +20,7 @@ from .fit import echo_untrusted, energy_warnings, read_input
 from .options import ReadInput, channel_labels, command, fit_options
 
 if TYPE_CHECKING:
-    from ..fitting.options import FitOptions
+    from ..fitting.problem.options import FitOptions
 
 #: the library's argument names -> this verb's options (errors name the options)
 OPTIONS = COMPARE_OPTIONS
@@ -35,7 +35,7 @@ def run_compare(file: str, models: str | None, out: str | None, options: FitOpti
     did not converge, or the best candidate (by the cross-validation score; BIC with
     ``--no-cv``) has a parameter on a search limit or
     gains energy: one ``warning:`` line each)."""
-    from ..fitting.compare import compare
+    from ..fitting.choice.compare import compare
     from ..jsonsafe import clean_json
     from ..output import ResultFolder
 

@@ -16,7 +16,8 @@ within that angle of the direction toward the source (``rb.fit(..., theta_r_max=
 source_exclusion=)`` in radians), ``--no-plots`` skips the figures (and
 Matplotlib). ``--bounds NAME=LOW:HIGH`` overrides a parameter's search range; ``--angles-in``
 states the angle unit of an ASTM or CSV file that does not. ``--model auto`` fits the
-candidates of ``roughbrdf.fitting.compare.AUTO_CANDIDATES`` (or those of ``--models``) and keeps
+candidates of ``roughbrdf.fitting.choice.compare.AUTO_CANDIDATES`` (or those of ``--models``) and
+keeps
 the best by leave-one-incidence-out prediction, with the comparison in ``fit.json``, the report
 and ``compare.png``
 (``--no-cv``: without the leave-one-incidence-out score). ``--joint`` fits all channels at
@@ -61,8 +62,8 @@ from .options import (
 )
 
 if TYPE_CHECKING:
-    from ..fitting.options import FitOptions
-    from ..fitting.result import FitResult
+    from ..fitting.problem.options import FitOptions
+    from ..fitting.results.result import FitResult
     from ..measurement import Measurement
     from ..models import Model
 
@@ -279,9 +280,9 @@ def run_per_incidence(file: str, out: str, given: ModelInput, options: FitOption
                       read: ReadInput, *, max_rows: int, force: bool, quiet: bool) -> int:
     """``roughbrdf fit --per-incidence``: one parameter set per measured incidence, at most
     ``--max-rows`` rows kept as an optical code's catalog holds them
-    (:func:`roughbrdf.fitting.per_incidence.fit_per_incidence`); writes ``fit.json`` and
+    (:func:`roughbrdf.fitting.kinds.per_incidence.fit_per_incidence`); writes ``fit.json`` and
     ``report.txt``. Exit status 1 as for a fit, if any row's fit is not to be trusted."""
-    from ..fitting.per_incidence import fit_per_incidence
+    from ..fitting.kinds.per_incidence import fit_per_incidence
     from ..output import ResultFolder
 
     if given.auto:
@@ -311,7 +312,7 @@ def run_fit(file: str, out: str, given: ModelInput, options: FitOptions, read: R
     (:meth:`roughbrdf.output.ResultFolder.check`).
     """
     from ..fitting import fit
-    from ..fitting.auto import fit_auto
+    from ..fitting.choice.auto import fit_auto
     from ..output import ResultFolder
 
     m, options = resolve_model(given, options)
@@ -336,9 +337,9 @@ def run_fit(file: str, out: str, given: ModelInput, options: FitOptions, read: R
 
 @contextlib.contextmanager
 def energy_warnings() -> Iterator[None]:
-    """Silence the :class:`~roughbrdf.fitting.plausibility.EnergyWarning` of a fit: the CLI
+    """Silence the :class:`~roughbrdf.fitting.results.plausibility.EnergyWarning` of a fit: the CLI
     words them itself (:func:`echo_untrusted`), one ``warning:`` line each."""
-    from ..fitting.plausibility import EnergyWarning
+    from ..fitting.results.plausibility import EnergyWarning
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", EnergyWarning)

@@ -30,7 +30,7 @@ from .fit import OPTIONS, resolve_model
 from .options import ModelInput, check_format, check_search, command, fit_options
 
 if TYPE_CHECKING:
-    from ..fitting.options import FitOptions
+    from ..fitting.problem.options import FitOptions
 
 #: the library's argument names -> this verb's options (errors name the options)
 BATCH_OPTIONS = {**OPTIONS, "n_workers": "--workers", "scheduler": "--scheduler",

@@ -3,7 +3,8 @@
 Each option is one entry of :data:`TABLE` (its typer annotation, with the help text, and its
 default). A verb lists the names of its parameters in order (:func:`command` gives the verb
 function the :class:`inspect.Signature` typer reads) and receives them as keywords; what it got
-becomes a :class:`~roughbrdf.fitting.options.FitOptions` (:func:`fit_options`, degrees turned
+becomes a :class:`~roughbrdf.fitting.problem.options.FitOptions` (:func:`fit_options`, degrees
+turned
 into radians and checked in CLI terms), a :class:`ModelInput` (``--model``, ``-p``, ``--fix``,
 ``--bounds``, ``--models``; resolved on the model by
 :func:`roughbrdf.cli.fit.resolve_model`) and a :class:`ReadInput` (``--quantity``, ``--angles-in``,
@@ -28,7 +29,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 if TYPE_CHECKING:
-    from ..fitting.options import FitOptions
+    from ..fitting.problem.options import FitOptions
 
 __all__ = ["TABLE", "ModelInput", "OptionError", "ReadInput", "channel_labels",
            "check_aperture", "check_format", "check_search", "command", "fit_domain",
@@ -289,7 +290,7 @@ def check_search(starts: int | None, loss: str | None, seed: int | None,
     if seed is not None and seed < 0:  # numpy's generators take no negative seed
         raise ValueError(f"--seed must be >= 0 (got {seed})")
     if relative_to is not None:
-        try:  # what a relative file's values are proportional to (fitting.data.Comparison)
+        try:  # what a relative file's values are proportional to (fitting.problem.data.Comparison)
             Quantity.RELATIVE.compared_with(relative_to)
         except ValueError:
             raise unknown_value("--relative-to", relative_to, ["brdf", "bridf"]) from None
@@ -299,18 +300,18 @@ def fit_domain(theta_r_max: float | None, source_exclusion: float | None
                ) -> tuple[float | None, float | None]:
     """``--theta-r-max``, ``--source-exclusion`` (degrees) -> radians, checked by the library
     (errors name the options, in degrees)."""
-    from ..fitting.data import check_fit_domain
+    from ..fitting.problem.data import check_fit_domain
 
     return check_fit_domain(*(None if v is None else math.radians(v)
                               for v in (theta_r_max, source_exclusion)))
 
 
 def fit_options(values: Mapping[str, Any], *, progress: bool | None = None) -> FitOptions:
-    """The :class:`~roughbrdf.fitting.options.FitOptions` of a verb's values, without
+    """The :class:`~roughbrdf.fitting.problem.options.FitOptions` of a verb's values, without
     ``--fix`` and ``--bounds`` (they need the model: :func:`roughbrdf.cli.fit.resolve_model`):
     angles in degrees checked and turned into radians, ``--keep-extrapolated`` as
     ``extrapolated``; the search options checked in CLI terms (:func:`check_search`)."""
-    from ..fitting.options import FitOptions
+    from ..fitting.problem.options import FitOptions
 
     # --relative-to is left to the library here: fit and compare name it (with the value and
     # the choices); fit-batch checks it too, before any cluster starts

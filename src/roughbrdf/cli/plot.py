@@ -191,14 +191,14 @@ def _fit_samples(fit: dict[str, Any], chan: dict[str, Any], meas: Any, ch: int, 
     """The samples of channel ``ch`` the fit used, as it compared them, and a note of those left
     out and why.
 
-    The selection is the fit's own (:func:`roughbrdf.fitting.data.prepare_channel` with the
+    The selection is the fit's own (:func:`roughbrdf.fitting.problem.data.prepare_channel` with the
     options of ``fit.json``); the values are multiplied by the fitted scale ``K`` and labelled
     with the compared quantity, as :meth:`FitResult.plot_data
     <roughbrdf.fitting.FitResult.plot_data>` does.
     """
     from dataclasses import replace
 
-    from ..fitting.data import Comparison, DataOptions, excluded_text, prepare_channel
+    from ..fitting.problem.data import Comparison, DataOptions, excluded_text, prepare_channel
     from ..quantity import Quantity
 
     o = fit.get("options")
@@ -227,7 +227,7 @@ def _fit_figure(fit: dict[str, Any], fit_dir: Path, meas: Any, chan: dict[str, A
                 aperture: Any) -> Any:
     """Data vs model and the residual maps of one channel of the fit, on the fit's samples."""
     from .. import plot_fit
-    from ..fitting.result import channel_model
+    from ..fitting.results.result import channel_model
 
     model = channel_model(fit, chan)
     label = chan.get("channel")
@@ -244,7 +244,7 @@ def _fit_figures(fit_dir: Path, out: Path | None, channel: str | None, force: bo
                  ) -> list[Path]:
     """Draw the comparison of each channel of the fit in ``fit_dir``: into ``out``, or added to
     the fit's results in its folder; everything is checked before the drawing."""
-    from ..fitting.result import check_fit_channels, read_fit_json
+    from ..fitting.results.result import check_fit_channels, read_fit_json
     from ..output import ResultFolder
     from ..result_check import check_result_folder
 

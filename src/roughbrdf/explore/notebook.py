@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any
 from ..errors import ArgumentError
 
 if TYPE_CHECKING:
-    from ..fitting.result import FitResult
+    from ..fitting.results.result import FitResult
     from ..measurement import Measurement
     from ..models import Model
 
@@ -238,7 +238,7 @@ def explore(model_or_fit: Model | FitResult | Measurement | str,
     >>> round(ex.model.params["rho"], 6), round(float(np.degrees(ex.theta_i)), 3)
     (0.3, 35.0)
     """
-    from ..fitting.result import FitResult
+    from ..fitting.results.result import FitResult
     from ..measurement import Measurement
     from ..models import Model
     from ..models.factory import as_model

@@ -86,7 +86,7 @@ def export(source: Any, out: str | os.PathLike, *, to: str, overwrite: bool = Fa
     ----------
     source : Model, FitResult or mapping
         A model (``rb.model``), a fit (``rb.fit``), or ``{channel: model}``
-        (:func:`roughbrdf.fitting.result.fitted_models` reads one from a fit's folder).
+        (:func:`roughbrdf.fitting.results.result.fitted_models` reads one from a fit's folder).
     out : str or path-like
         The file (``.bsdf``, ``.json`` or ``.xml`` added without a suffix). A fit whose
         channels are not one BSDF gives one file per channel, ``<stem>_<channel><suffix>``
@@ -155,7 +155,7 @@ def _channel_models(source: Any, channel: Any) -> list[tuple[str | None, Any, An
     """``[(label, source, channel)]`` to write one file each (label None: the file named
     ``out`` itself): a model or a per-incidence fit as it is; a fit or ``{channel: model}``
     one per channel (or ``channel`` alone)."""
-    from ..fitting.result import FitResult
+    from ..fitting.results.result import FitResult
 
     if isinstance(source, FitResult):
         labels = [c.channel for c in source.channels]

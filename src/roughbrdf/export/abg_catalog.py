@@ -8,7 +8,7 @@ the first row below it and the last above), ``A``, ``B``, ``g``, with a TIS butt
 "must be less than 1.0" (OpticStudio help, "ABg Scatter Data Catalogs"). The file's own text
 layout is not publicly documented, so this module does not write one: it writes a clearly
 labelled text table of exactly those fields — one row per kept incidence of a
-:func:`~roughbrdf.fitting.per_incidence.fit_per_incidence`, or a single row (``Angle 0``,
+:func:`~roughbrdf.fitting.kinds.per_incidence.fit_per_incidence`, or a single row (``Angle 0``,
 serving every incidence) for a fit of one parameter set — plus each row's TIS
 (:func:`roughbrdf.albedo`), to type into the dialog.
 
@@ -67,8 +67,8 @@ def abg_rows(source: Any, channel: str | int | None = None) -> tuple[list[AbgRow
     >>> rows[0].angle_deg, rows[0].A, round(rows[0].tis, 3)
     (0.0, 0.01, 0.217)
     """
-    from ..fitting.per_incidence import PerIncidenceFit
-    from ..fitting.result import FitResult
+    from ..fitting.kinds.per_incidence import PerIncidenceFit
+    from ..fitting.results.result import FitResult
     from ..integrate import albedo
 
     ch: str | None
@@ -156,7 +156,7 @@ def write_abg_catalog(source: Any, out: str | os.PathLike, *, name: str | None =
     digits, ``_`` and ``-``); ``wavelength_um``: "Wave" (default: the channel's wavelength
     when its label is one, e.g. ``"630nm"``, else 0).
     """
-    from ..fitting.plausibility import refuse_energy_gain
+    from ..fitting.results.plausibility import refuse_energy_gain
     from ..models.kcorr import parse_wavelength
     from ..output import atomic_write, refuse_existing
 

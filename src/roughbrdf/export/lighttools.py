@@ -199,7 +199,7 @@ def to_lighttools(model: Any, out: str | os.PathLike, *, angles_of_incidence: An
     allow_energy_gain : bool
         Write a roughbrdf model whose albedo exceeds ``1 + 1e-3`` at some incidence (recorded
         in a comment); refused by default
-        (:func:`~roughbrdf.fitting.plausibility.refuse_energy_gain`).
+        (:func:`~roughbrdf.fitting.results.plausibility.refuse_energy_gain`).
 
     Returns
     -------
@@ -218,7 +218,7 @@ def to_lighttools(model: Any, out: str | os.PathLike, *, angles_of_incidence: An
     >>> bool(abs(m.values[:, 0] - 0.5 / 3.141592653589793).max() < 1e-8)
     True
     """
-    from ..fitting.plausibility import refuse_energy_gain
+    from ..fitting.results.plausibility import refuse_energy_gain
     from ..integrate import albedo
     from ..models.base import Model
 

@@ -255,7 +255,7 @@ def _models(obj: Any, channel: Any) -> list[tuple[str | None, Model]]:
             raise ArgumentError("channel", "applies to a fit; a model is one file", value=channel)
         return [(None, obj)]
     if isinstance(obj, Mapping) and obj and all(isinstance(m, Model) for m in obj.values()):
-        # {channel: model}, e.g. roughbrdf.fitting.result.fitted_models(fit folder)
+        # {channel: model}, e.g. roughbrdf.fitting.results.result.fitted_models(fit folder)
         if channel is None:
             return [(str(k), m) for k, m in obj.items()]
         key = channel if channel in obj else list(obj)[int(channel)] \
@@ -315,7 +315,8 @@ def to_zemax(model_or_fit: Any, out: str | os.PathLike, *, angles_of_incidence: 
     Parameters
     ----------
     model_or_fit : Model, FitResult or mapping
-        A fit (or ``{channel: model}``, e.g. :func:`roughbrdf.fitting.result.fitted_models` of
+        A fit (or ``{channel: model}``, e.g. :func:`roughbrdf.fitting.results.result.fitted_models`
+        of
         a saved fit) writes one file per channel, ``<stem>_<channel>.bsdf`` beside ``out``.
     out : str or path-like
         The file (``.bsdf`` added when it has no suffix).
@@ -333,7 +334,7 @@ def to_zemax(model_or_fit: Any, out: str | os.PathLike, *, angles_of_incidence: 
         Write a model that reflects more than it receives (albedo above ``1 + 1e-3`` at an
         incidence of 0, 5, ... 85, 89 deg), recorded in a header comment; by default refused
         with an :class:`~roughbrdf.errors.ArgumentError` naming the albedo and the incidence
-        (:func:`~roughbrdf.fitting.plausibility.refuse_energy_gain`).
+        (:func:`~roughbrdf.fitting.results.plausibility.refuse_energy_gain`).
 
     Returns
     -------
@@ -353,7 +354,7 @@ def to_zemax(model_or_fit: Any, out: str | os.PathLike, *, angles_of_incidence: 
     >>> bool(abs(m.values[:, 0] - 0.5 / 3.141592653589793).max() < 1e-12)
     True
     """
-    from ..fitting.plausibility import refuse_energy_gain
+    from ..fitting.results.plausibility import refuse_energy_gain
 
     pairs = _models(model_or_fit, channel)
     targets = _targets(out, [c for c, _ in pairs], single=len(pairs) == 1 and (

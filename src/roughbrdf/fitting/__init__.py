@@ -8,36 +8,32 @@ fitter reads ``model.parameters`` (value, bounds) and rebuilds the model with
 (trust-region reflective, box bounds) minimizes the sum of squared residuals, one per sample:
 ``(K x - f)/f`` by default, whose r.m.s. is TR75's sigma (Eq. 34).
 
-This package face only re-exports. One job per module:
+This package face only re-exports. Its inner rooms, lowest first (a room imports only the
+rooms before it; ``tests/test_layers.py`` holds the order):
 
-=========================================  ===================================================
-:mod:`~roughbrdf.fitting.fit`              :func:`fit`: options from keywords; routes Mueller
-                                           data, ``"auto"`` and a named model
-:mod:`~roughbrdf.fitting.options`          :class:`FitOptions`: every option, typed, checked
-                                           once when made
-:mod:`~roughbrdf.fitting.plan`             what needs the model or data, checked before any
-                                           work: free parameters, bounds, the data scale ``K``
-:mod:`~roughbrdf.fitting.channels`         the fit of one named model: channel by channel or
-                                           jointly, Mueller data to ``polarimetric``
-:mod:`~roughbrdf.fitting.data`             one channel's samples: the compared quantity, what
-                                           is left out (and counted), the weights
-:mod:`~roughbrdf.fitting.objective`        the weighted residuals (the loss's,
-                                           :class:`roughbrdf.quantity.Loss`) and the compiled
-                                           finite-difference Jacobians
-:mod:`~roughbrdf.fitting.search`           Sobol screening, multistart exploration, polish
-:mod:`~roughbrdf.fitting.joint`            joint fits of several channels
-:mod:`~roughbrdf.fitting.polarimetric`     Mueller-matrix data, all elements at once
-:mod:`~roughbrdf.fitting.compare`          model choice: ``compare``, CV, ranking
-:mod:`~roughbrdf.fitting.auto`             ``fit_auto``: the candidates in two stages, a
-                                           candidate far behind skipped after one channel
-:mod:`~roughbrdf.fitting.statistics`       covariance, stderr, correlations, chi2, AIC/BIC,
-                                           sigma, rms-log
-:mod:`~roughbrdf.fitting.result`           :class:`ChannelFit`, :class:`FitResult`, JSON,
-                                           plots, saving
-:mod:`~roughbrdf.fitting.report`           the text report
-:mod:`~roughbrdf.fitting.threads`          one BLAS thread during a fit (threadpoolctl)
-:mod:`roughbrdf.instrument`                the instrument aperture (cone average)
-=========================================  ===================================================
+======================  ===================================================================
+room                    what it holds
+======================  ===================================================================
+:mod:`.problem`         one channel's samples (``data``), residuals and Jacobians
+                        (``objective``), :class:`FitOptions` (``options``), the search
+                        settings (``search_options``), the plan checked before any work
+                        (``plan``), the channels' wavelengths (``wavelengths``)
+:mod:`.solvers`         the global search (``search``), bounded and constrained
+                        Levenberg-Marquardt (``bounded``, ``constrained``), first-order
+                        optimality (``stationary``), one BLAS thread (``threads``)
+:mod:`.results`         :class:`FitResult` and :class:`ChannelFit` (``result``), covariance
+                        and goodness of fit (``statistics``), the report (``report``),
+                        albedo and peak checks (``plausibility``), parameter ranges
+                        (``physical``)
+:mod:`.energy`          the energy constraint (albedo <= 1) of a channel's fit
+:mod:`.kinds`           channel by channel (``channels``), joint (``joint``), Mueller data
+                        (``polarimetric``), per incidence (``per_incidence``)
+:mod:`.choice`          ``compare`` and the held-out score (``compare``), ``--model auto``
+                        (``auto``)
+:mod:`.load`            a saved fit folder read back as a :class:`FitResult`
+:mod:`.fit`             :func:`fit`: options from keywords; routes Mueller data,
+                        ``"auto"`` and a named model
+======================  ===================================================================
 
 Importing this package loads neither SciPy nor Matplotlib: they are imported when a fit runs
 or a plot is drawn.
@@ -47,15 +43,15 @@ from __future__ import annotations
 
 from ..instrument import APERTURE_POINTS, aperture_average, aperture_stencil
 from ..quantity import LOSSES, Loss
-from .auto import fit_auto
-from .compare import AUTO_CANDIDATES, ModelComparison, compare
-from .data import ChannelData
+from .choice.auto import fit_auto
+from .choice.compare import AUTO_CANDIDATES, ModelComparison, compare
 from .fit import fit
-from .objective import Objective, ObjectiveSpec
-from .options import FitOptions
-from .plan import FitPlan
-from .plausibility import EnergyWarning
-from .result import ChannelFit, FitResult
+from .problem.data import ChannelData
+from .problem.objective import Objective, ObjectiveSpec
+from .problem.options import FitOptions
+from .problem.plan import FitPlan
+from .results.plausibility import EnergyWarning
+from .results.result import ChannelFit, FitResult
 
 __all__ = ["fit", "FitOptions", "compare", "fit_auto", "AUTO_CANDIDATES", "ModelComparison",
            "FitResult", "ChannelFit", "FitPlan", "LOSSES", "Loss", "APERTURE_POINTS",

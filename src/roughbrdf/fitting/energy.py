@@ -2,9 +2,9 @@
 
 ``docs/fitting.md`` ("Energy constraint"). TR75 with ``rho_L``, TS67, RB08 and sums of models
 can reflect more than they receive for some parameter values. After a channel's search
-(:func:`roughbrdf.fitting.channels.fit_channels`), when the fitted model gains energy on the
-grid :data:`~roughbrdf.fitting.plausibility.EXPORT_INCIDENCES_DEG` (0, 5, ... 85, 89 deg;
-the test of :func:`~roughbrdf.fitting.plausibility.energy_gain`, the accurate
+(:func:`roughbrdf.fitting.kinds.channels.fit_channels`), when the fitted model gains energy on the
+grid :data:`~roughbrdf.fitting.results.plausibility.EXPORT_INCIDENCES_DEG` (0, 5, ... 85, 89 deg;
+the test of :func:`~roughbrdf.fitting.results.plausibility.energy_gain`, the accurate
 :func:`roughbrdf.albedo`),
 the channel is refitted from that optimum under the constraint ``albedo(theta_i) <= 1`` at every
 incidence of the grid (:func:`constrain_channel`):
@@ -19,16 +19,16 @@ incidence of the grid (:func:`constrain_channel`):
   ``W max(0, A_k(theta) - target)``, ``target = 1 -`` :data:`MARGIN`
   (:class:`ConstrainedObjective`, forward-difference Jacobian rows), with ``W^2 = lambda *
   cost`` of the start point and ``lambda = 1 / sum(excess^2)`` in the first round; the polish
-  of :func:`~roughbrdf.fitting.search.polish_fit` runs on it unchanged, on
+  of :func:`~roughbrdf.fitting.solvers.search.polish_fit` runs on it unchanged, on
   :data:`ROUND_SAMPLES` samples of the channel, at most :data:`ROUND_NFEV` evaluations;
 * after each round the accurate albedo is checked; while it exceeds ``1 +``
-  :data:`~roughbrdf.fitting.plausibility.ENERGY_TOLERANCE` somewhere, ``lambda`` grows by
+  :data:`~roughbrdf.fitting.results.plausibility.ENERGY_TOLERANCE` somewhere, ``lambda`` grows by
   :data:`GROWTH` (at most :data:`MAX_ROUNDS` rounds; then the fit says it could not, and the
-  usual :class:`~roughbrdf.fitting.plausibility.EnergyWarning` follows);
+  usual :class:`~roughbrdf.fitting.results.plausibility.EnergyWarning` follows);
 * the rounds keep the refit in the unconstrained optimum's basin but do not converge on the
   constraint (the hinge makes the cost non-smooth there); the best round's point is finished
   on all samples under the constraint itself,
-  :func:`~roughbrdf.fitting.constrained.constrained_lm` (:func:`_finish`, at most
+  :func:`~roughbrdf.fitting.solvers.constrained.constrained_lm` (:func:`_finish`, at most
   :data:`FINISH_PASSES` passes), and kept when the constraint holds.
 
 At a constrained optimum the covariance is the data's, projected on the directions along which
@@ -48,16 +48,16 @@ import numpy as np
 
 from ..models.base import PreparedGeometry
 from ..polarization import Polarization
-from .constrained import Limits, constrained_lm, finite_limits
-from .objective import BAD_RESIDUAL, EPS_STEP, Objective, ObjectiveSpec
-from .plausibility import ENERGY_TOLERANCE, EXPORT_INCIDENCES_DEG, albedo_by_incidence
-from .search import POLISH_TOL, SearchOutcome, polish_fit
-from .statistics import Covariance
+from .problem.objective import BAD_RESIDUAL, EPS_STEP, Objective, ObjectiveSpec
+from .results.plausibility import ENERGY_TOLERANCE, EXPORT_INCIDENCES_DEG, albedo_by_incidence
+from .results.statistics import Covariance
+from .solvers.constrained import Limits, constrained_lm, finite_limits
+from .solvers.search import POLISH_TOL, SearchOutcome, polish_fit
 
 if TYPE_CHECKING:
     from ..models import Model
-    from .data import ChannelData
-    from .result import ChannelFit
+    from .problem.data import ChannelData
+    from .results.result import ChannelFit
 
 __all__ = ["ConstrainedObjective", "EnergyConstraint", "FastAlbedo", "FAST_ALBEDO_ACCURACY",
            "MAX_ROUNDS", "checked_albedo", "conditional_covariance", "constrain_channel",
@@ -194,7 +194,7 @@ def fast_albedo(model: Model, theta_deg: tuple[float, ...] = EXPORT_INCIDENCES_D
 
 @dataclass(eq=False)
 class ConstrainedObjective(Objective):
-    """An :class:`~roughbrdf.fitting.objective.Objective` with one penalty residual per
+    """An :class:`~roughbrdf.fitting.problem.objective.Objective` with one penalty residual per
     incidence of the grid appended: ``weight * max(0, A_k(theta) + bias_k - target)``.
 
     ``A`` is :func:`fast_albedo`; ``bias`` its defect correction (accurate - fast at the
@@ -247,8 +247,8 @@ class ConstrainedObjective(Objective):
 @dataclass(eq=False)
 class AlbedoLimits:
     """The constraint ``A_k(theta) + bias_k - target <= 0`` at the watched incidences of the
-    grid, as :class:`~roughbrdf.fitting.constrained.Limits` for
-    :func:`~roughbrdf.fitting.constrained.constrained_lm`.
+    grid, as :class:`~roughbrdf.fitting.solvers.constrained.Limits` for
+    :func:`~roughbrdf.fitting.solvers.constrained.constrained_lm`.
 
     ``A`` is :func:`fast_albedo`; ``bias`` its defect correction (accurate - fast at the
     pass's start point); the Jacobian is forward differences (one fast albedo per parameter).
@@ -478,7 +478,7 @@ def _run_rounds(obj: ConstrainedObjective, theta: np.ndarray, accurate: np.ndarr
 def _finish(spec: ObjectiveSpec, data: ChannelData, state: _Rounds, max_nfev: int | None,
             tried: list[dict[str, Any]]) -> int:
     """The refit of the best round's point on all samples of ``data`` under the constraint
-    itself (:func:`~roughbrdf.fitting.constrained.constrained_lm`, the fast albedo corrected
+    itself (:func:`~roughbrdf.fitting.solvers.constrained.constrained_lm`, the fast albedo corrected
     at each pass's start), to convergence; a pass that ends with the accurate albedo above the
     tolerance is followed by another from its end (at most :data:`FINISH_PASSES`). Kept when
     it satisfies the constraint, or lowers the albedo of rounds that did not (``state``

@@ -1,11 +1,12 @@
 """``rb.fit``: the one entry point of fitting, and where it routes (``docs/fitting.md``).
 
-:func:`fit` turns its keywords into a :class:`~roughbrdf.fitting.options.FitOptions` (or takes
+:func:`fit` turns its keywords into a :class:`~roughbrdf.fitting.problem.options.FitOptions` (or
+takes
 one, ``options=``) and sends the work on: Mueller data to
-:func:`~roughbrdf.fitting.polarimetric.fit_mueller` and a named model to
-:func:`~roughbrdf.fitting.channels.fit_model`, ``"auto"`` to model choice
-(:func:`~roughbrdf.fitting.auto.fit_auto`). No module of the package imports this one:
-model choice fits its candidates through :mod:`~roughbrdf.fitting.channels`.
+:func:`~roughbrdf.fitting.kinds.polarimetric.fit_mueller` and a named model to
+:func:`~roughbrdf.fitting.kinds.channels.fit_model`, ``"auto"`` to model choice
+(:func:`~roughbrdf.fitting.choice.auto.fit_auto`). No module of the package imports this one:
+model choice fits its candidates through :mod:`~roughbrdf.fitting.kinds.channels`.
 """
 
 from __future__ import annotations
@@ -13,14 +14,14 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from ..models.factory import is_auto
-from .auto import fit_auto
-from .channels import fit_model, is_mueller, refuse_polarimetric_weight
-from .options import FitOptions
+from .choice.auto import fit_auto
+from .kinds.channels import fit_model, is_mueller, refuse_polarimetric_weight
+from .problem.options import FitOptions
 
 if TYPE_CHECKING:
     from ..measurement import Measurement
     from ..models import Model
-    from .result import FitResult
+    from .results.result import FitResult
 
 __all__ = ["fit"]
 
@@ -34,14 +35,14 @@ def fit(model: Model | str, measurement: Measurement, *, options: FitOptions | N
     model : Model or str
         Model with starting values (``rb.model(...)``; sums allowed), a registered name or
         spec (``"coated(lobes=2)"``), or ``"auto"``: fit the candidates of
-        :data:`~roughbrdf.fitting.compare.AUTO_CANDIDATES` and keep the best by
+        :data:`~roughbrdf.fitting.choice.compare.AUTO_CANDIDATES` and keep the best by
         cross-validation (BIC beside it), with
         every candidate's figures and a leave-one-incidence-out score in ``model_choice``
-        (:func:`~roughbrdf.fitting.auto.fit_auto`; ``fix`` and ``bounds`` do not apply).
+        (:func:`~roughbrdf.fitting.choice.auto.fit_auto`; ``fix`` and ``bounds`` do not apply).
     measurement : Measurement
         The data (:func:`roughbrdf.read`).
     options : FitOptions, optional
-        The options, typed (:class:`~roughbrdf.fitting.options.FitOptions`, which documents
+        The options, typed (:class:`~roughbrdf.fitting.problem.options.FitOptions`, which documents
         each one); default: the defaults.
     **keywords
         The options by name, replacing those of ``options``: ``channel``, ``loss``,
@@ -49,12 +50,13 @@ def fit(model: Model | str, measurement: Measurement, *, options: FitOptions | N
         ``relative_to``, ``free_scale``, ``scale``, ``screen``, ``subsample``, ``polish``,
         ``max_nfev``, ``aperture``, ``aperture_points``, ``theta_r_max``,
         ``source_exclusion``, ``extrapolated``, ``joint``, ``shared``,
-        ``polarimetric_weight``, ``progress`` (:class:`~roughbrdf.fitting.options.FitOptions`).
+        ``polarimetric_weight``, ``progress``
+        (:class:`~roughbrdf.fitting.problem.options.FitOptions`).
 
     Returns
     -------
     FitResult
-        For Mueller data a :class:`~roughbrdf.fitting.polarimetric.MuellerFitResult`: every
+        For Mueller data a :class:`~roughbrdf.fitting.kinds.polarimetric.MuellerFitResult`: every
         element is fitted at once (one channel, ``"mueller"``; ``docs/fitting.md``,
         "Polarimetric data").
 

@@ -1,18 +1,20 @@
-"""``rb.load_fit``: the :class:`~roughbrdf.fitting.result.FitResult` of a saved fit folder.
+"""``rb.load_fit``: the :class:`~roughbrdf.fitting.results.result.FitResult` of a saved fit folder.
 
-A fit folder (:meth:`FitResult.save <roughbrdf.fitting.result.FitResult.save>`, ``roughbrdf fit
+A fit folder (:meth:`FitResult.save <roughbrdf.fitting.results.result.FitResult.save>`, ``roughbrdf
+fit
 FILE --out DIR``) holds ``fit.json``: the model of each channel, its parameters, standard errors,
 correlations, figures of merit and message, the fit's options and the input file as it was
 (``file``, ``file_abspath``, ``file_sha256``; ``docs/fitting.md``, "Output files").
 :func:`load_fit` reads it back, re-reads the measurement from the recorded path and rebuilds the
-result: :meth:`~roughbrdf.fitting.result.FitResult.report`,
-:meth:`~roughbrdf.fitting.result.FitResult.predict` and
-:meth:`~roughbrdf.fitting.result.FitResult.plot` work as on the fit itself.
+result: :meth:`~roughbrdf.fitting.results.result.FitResult.report`,
+:meth:`~roughbrdf.fitting.results.result.FitResult.predict` and
+:meth:`~roughbrdf.fitting.results.result.FitResult.plot` work as on the fit itself.
 
 What ``fit.json`` does not hold is rebuilt or left empty, and said so:
 
 * the fitted samples (``index``, ``data``, ``fitted``, ``residual``) are selected again from the
-  measurement with the recorded options (:func:`~roughbrdf.fitting.data.prepare_channel`), the
+  measurement with the recorded options (:func:`~roughbrdf.fitting.problem.data.prepare_channel`),
+  the
   model evaluated there and the loss's residuals recomputed; a count that differs from the
   recorded ``n_points`` (weights given as an array are not in ``fit.json``) gives an
   :class:`InputChangedWarning`;
@@ -46,10 +48,10 @@ import numpy as np
 
 from ..errors import ArgumentError
 from ..instrument import Aperture
-from .data import Comparison, DataOptions, prepare_channel
 from .energy import EnergyConstraint
-from .objective import Objective, ObjectiveSpec
-from .result import MAX_FIT_JSON_BYTES, ChannelFit, FitResult, channel_model, read_fit_json
+from .problem.data import Comparison, DataOptions, prepare_channel
+from .problem.objective import Objective, ObjectiveSpec
+from .results.result import MAX_FIT_JSON_BYTES, ChannelFit, FitResult, channel_model, read_fit_json
 
 if TYPE_CHECKING:
     from ..measurement import Measurement
@@ -67,7 +69,7 @@ class InputChangedWarning(UserWarning):
 
 def load_fit(fit: str | os.PathLike, *, measurement: Measurement | str | os.PathLike | None
              = None) -> FitResult:
-    """The :class:`~roughbrdf.fitting.result.FitResult` of a saved fit folder.
+    """The :class:`~roughbrdf.fitting.results.result.FitResult` of a saved fit folder.
 
     Parameters
     ----------
@@ -159,12 +161,13 @@ def _refuse_other_kinds(path: Path, content: dict[str, Any] | None = None) -> No
         raise ValueError(
             f"{path}: a per-incidence fit (one parameter set per incidence, `roughbrdf fit "
             f"--per-incidence`), not one FitResult: read its rows with json.load (rb.export_to "
-            f"takes that dict), or refit with roughbrdf.fitting.per_incidence.fit_per_incidence")
+            f"takes that dict), or refit with "
+            f"roughbrdf.fitting.kinds.per_incidence.fit_per_incidence")
     opts = content.get("options")
     if isinstance(opts, dict) and opts.get("mueller") is not None:
         raise ValueError(
             f"{path}: a Mueller-matrix fit, which load_fit does not rebuild; its fitted model "
-            f"is roughbrdf.fitting.result.fitted_models({str(path.parent)!r})")
+            f"is roughbrdf.fitting.results.result.fitted_models({str(path.parent)!r})")
 
 
 def _options(content: dict[str, Any]) -> dict[str, Any]:
@@ -307,7 +310,7 @@ def _energy(rec: Any) -> EnergyConstraint | None:
 def _samples(content: dict[str, Any], model: Model, meas: Measurement, j: int,
              free: list[str], scale: float, free_scale: bool) -> dict[str, np.ndarray]:
     """``index``, ``data``, ``fitted`` and ``residual`` of channel ``j``: the samples the
-    recorded options select (:func:`~roughbrdf.fitting.data.prepare_channel`), the fitted
+    recorded options select (:func:`~roughbrdf.fitting.problem.data.prepare_channel`), the fitted
     model there (through the aperture) and the loss's residuals at the recorded scale."""
     opts = _options(content)
     ap = content.get("aperture")

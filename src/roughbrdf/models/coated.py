@@ -407,7 +407,7 @@ class Coated(Model):
         ``complements`` by ``1 - w`` gives the same model (lobe 1 and lobe 2 trade places); None
         for one or three lobes (three lobes' weights, :func:`lobe_weights`, are not symmetric
         under a pairwise exchange). The search uses it to treat a point and its mirror as one
-        end (:meth:`~roughbrdf.fitting.objective.ObjectiveSpec.canonical`).
+        end (:meth:`~roughbrdf.fitting.problem.objective.ObjectiveSpec.canonical`).
 
         Examples
         --------

@@ -13,7 +13,7 @@ reflectance of a part, ``roughbrdf.models.parameters``), but its search range is
 ``alpha`` 0.01-2, ``F = 1`` included; ``tests/models/test_coated_energy.py``). Without shadowing
 (``shadowing="none"``) it diverges at grazing incidence whatever ``ks``. A fit may be given a
 wider range (``bounds={"ks": (0, 20)}``); its report and ``fit.json`` then say it used a
-non-physical range (:mod:`roughbrdf.fitting.physical`). With data of unknown scale (a free
+non-physical range (:mod:`roughbrdf.fitting.results.physical`). With data of unknown scale (a free
 data scale ``K``) a lone microfacet lobe's ``ks`` and ``K`` are one degree of freedom: fix
 ``ks`` (``fix=["ks"]``, ``--fix ks``; ``K`` carries the scale, ``docs/fitting.md``).
 The parameter ``alpha`` is the width parameter of the chosen distribution: ``e`` for

@@ -1,5 +1,6 @@
 """Levenberg–Marquardt with the box bounds solved exactly, and the test that says a point is a
-minimum within the bounds: the end of the polish (:func:`roughbrdf.fitting.search.polish_fit`).
+minimum within the bounds: the end of the polish
+(:func:`roughbrdf.fitting.solvers.search.polish_fit`).
 
 ``docs/fitting.md`` ("Polish"). Each iteration minimizes the Gauss–Newton model of the cost,
 ``m(p) = 1/2 |f + J p|^2``, plus the damping ``1/2 lambda |D p|^2`` (``D`` the column norms
@@ -18,11 +19,11 @@ Converged means the model with the bounds predicts no worthwhile decrease: the u
 bounded step from the point lowers ``m`` by at most ``tol`` times the cost. This holds at a
 minimum in the interior (the gradient vanishes) and at one on the bounds (the gradient points
 out of the box), and fails at a point that only stopped moving. Or the point is first-order
-optimal (:func:`~roughbrdf.fitting.stationary.optimality` at most
-:data:`~roughbrdf.fitting.stationary.GTOL`: a stationary point where a Jacobian column
+optimal (:func:`~roughbrdf.fitting.solvers.stationary.optimality` at most
+:data:`~roughbrdf.fitting.solvers.stationary.GTOL`: a stationary point where a Jacobian column
 vanishes, which the predicted decrease does not see). Flat parameters do not move
-(:func:`~roughbrdf.fitting.stationary.flat`), and the end is settled on the bounds it is as
-good on (:func:`~roughbrdf.fitting.stationary.snap`): ``docs/fitting.md``, "The same answer
+(:func:`~roughbrdf.fitting.solvers.stationary.flat`), and the end is settled on the bounds it is as
+good on (:func:`~roughbrdf.fitting.solvers.stationary.snap`): ``docs/fitting.md``, "The same answer
 on every machine".
 """
 
@@ -36,8 +37,8 @@ from typing import Any
 
 import numpy as np
 
-from ..interrupts import held_interrupts
-from .objective import Objective
+from ...interrupts import held_interrupts
+from ..problem.objective import Objective
 from .stationary import GTOL, edges_of, flat, optimality, scaling, snap
 
 __all__ = ["BoundedResult", "GaussNewtonModel", "bounded_lm", "bounded_step", "settle"]
@@ -152,7 +153,7 @@ def bounded_lm(obj: Objective, x0: np.ndarray, tol: float, max_nfev: int | None 
     --------
     >>> import roughbrdf as rb
     >>> from roughbrdf.fitting import ChannelData
-    >>> from roughbrdf.fitting.objective import ObjectiveSpec
+    >>> from roughbrdf.fitting.problem.objective import ObjectiveSpec
     >>> spec = ObjectiveSpec(rb.model("lambertian", rho=0.9), ["rho"], [0.0], [0.2],
     ...                      loss="absolute")
     >>> data = ChannelData.from_arrays([0.1, 0.3], [0.2, 0.4], [0.0, 1.0], [0.1, 0.1])
@@ -207,7 +208,7 @@ def bounded_lm(obj: Objective, x0: np.ndarray, tol: float, max_nfev: int | None 
 def _settled(obj: Objective, x: np.ndarray, cost: float, status: int, message: str,
              nfev: int, njev: int) -> BoundedResult:
     """The result at ``x``, its parameters near a bound tried on it first
-    (:func:`~roughbrdf.fitting.stationary.snap`)."""
+    (:func:`~roughbrdf.fitting.solvers.stationary.snap`)."""
     x, cost, n = snap(x, cost, obj.spec.lower, obj.spec.upper, _cost_of(obj), edges_of(obj.spec))
     return BoundedResult(x, cost, status, message, nfev + n, njev)
 
@@ -222,13 +223,13 @@ def _cost_of(obj: Objective) -> Callable[[np.ndarray], float]:
 def settle(obj: Objective, res: Any) -> Any:
     """A local fit's result (``scipy.optimize.OptimizeResult`` or :class:`BoundedResult`)
     with its end settled on the bounds it is as good on
-    (:func:`~roughbrdf.fitting.stationary.snap`); ``res`` itself when nothing moved.
+    (:func:`~roughbrdf.fitting.solvers.stationary.snap`); ``res`` itself when nothing moved.
 
     Examples
     --------
     >>> import roughbrdf as rb
     >>> from roughbrdf.fitting import ChannelData
-    >>> from roughbrdf.fitting.objective import ObjectiveSpec
+    >>> from roughbrdf.fitting.problem.objective import ObjectiveSpec
     >>> spec = ObjectiveSpec(rb.model("lambertian", rho=0.9), ["rho"], [0.0], [1.0],
     ...                      loss="absolute")
     >>> data = ChannelData.from_arrays([0.1, 0.3], [0.2, 0.4], [0.0, 1.0], [0.0, 0.0])

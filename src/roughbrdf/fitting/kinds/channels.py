@@ -1,8 +1,9 @@
-"""The fit of one named model: Mueller data to :mod:`~roughbrdf.fitting.polarimetric`, every
-other measurement channel by channel (or jointly, :mod:`~roughbrdf.fitting.joint`).
+"""The fit of one named model: Mueller data to :mod:`~roughbrdf.fitting.kinds.polarimetric`, every
+other measurement channel by channel (or jointly, :mod:`~roughbrdf.fitting.kinds.joint`).
 
 What :func:`roughbrdf.fit` runs for a model that is not ``"auto"``, and what model choice
-(:mod:`~roughbrdf.fitting.compare`) runs for each candidate: :func:`fit_model`. Each channel is
+(:mod:`~roughbrdf.fitting.choice.compare`) runs for each candidate: :func:`fit_model`. Each channel
+is
 fitted on its own by default; ``scipy.optimize.least_squares`` (trust-region reflective, box
 bounds) minimizes the sum of squared residuals, one per sample: by default the soft-L1
 transform of ``ln(K x) - ln f`` (the ``robust`` loss; TR75's sigma, Eq. 34, is reported
@@ -21,24 +22,24 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import ArgumentError
-from ..models.factory import as_model, spec_text
-from .data import ChannelData, prepare_channel
-from .energy import EnergyConstraint, conditional_covariance, constrain_channel, refit_constrained
+from ...errors import ArgumentError
+from ...models.factory import as_model, spec_text
+from ..energy import EnergyConstraint, conditional_covariance, constrain_channel, refit_constrained
+from ..problem.data import ChannelData, prepare_channel
+from ..problem.objective import ObjectiveSpec
+from ..problem.plan import FitPlan, channel_indices, check_enough_data
+from ..problem.wavelengths import channel_wavelength, needs_wavelength, with_wavelength
+from ..results.plausibility import EXPORT_INCIDENCES_DEG, warn_energy
+from ..results.result import ChannelFit, FitResult
+from ..solvers.search import MultiStart, SearchOptions, progress_bar
+from ..solvers.threads import single_thread_blas
 from .joint import fit_joint
-from .objective import ObjectiveSpec
-from .plan import FitPlan, channel_indices, check_enough_data
-from .plausibility import EXPORT_INCIDENCES_DEG, warn_energy
 from .polarimetric import fit_mueller
-from .result import ChannelFit, FitResult
-from .search import MultiStart, SearchOptions, progress_bar
-from .threads import single_thread_blas
-from .wavelengths import channel_wavelength, needs_wavelength, with_wavelength
 
 if TYPE_CHECKING:
-    from ..measurement import Measurement
-    from ..models import Model
-    from .options import FitOptions
+    from ...measurement import Measurement
+    from ...models import Model
+    from ..problem.options import FitOptions
 
 __all__ = ["fit_model", "fit_channels", "is_mueller", "refuse_polarimetric_weight"]
 
@@ -60,15 +61,16 @@ def fit_model(model: Model | str, measurement: Measurement, options: FitOptions,
               check_energy: bool = True, refit: bool = False,
               done: list[ChannelFit] | None = None) -> FitResult:
     """Fit one model (an instance, a name or a spec; not ``"auto"``) with ``options``:
-    Mueller data with :func:`~roughbrdf.fitting.polarimetric.fit_mueller`, others with
+    Mueller data with :func:`~roughbrdf.fitting.kinds.polarimetric.fit_mueller`, others with
     :func:`fit_channels`. With ``check_energy``, an
-    :class:`~roughbrdf.fitting.plausibility.EnergyWarning` for each channel whose fitted model
+    :class:`~roughbrdf.fitting.results.plausibility.EnergyWarning` for each channel whose fitted
+    model
     reflects more than it receives (the refits of a cross-validation skip the check). With
     ``refit`` (a cross-validation fold: ``model`` holds a fit's optimum), a channel fitted
     under the energy constraint is refitted from that optimum under the constraint directly
     (:func:`~roughbrdf.fitting.energy.refit_constrained`). ``done``: the fits of the first
     channels, made before by this same call with those channels alone
-    (:mod:`~roughbrdf.fitting.auto`'s first stage): kept as they are, and the search goes on
+    (:mod:`~roughbrdf.fitting.choice.auto`'s first stage): kept as they are, and the search goes on
     from them as it would have (:func:`fit_channels`); the result is the whole fit's."""
     res: FitResult
     if is_mueller(measurement):  # Mueller elements: all at once
@@ -85,7 +87,8 @@ def fit_model(model: Model | str, measurement: Measurement, options: FitOptions,
 
 def _by_wavelength(model: Model, measurement: Measurement, options: FitOptions,
                    done: list[ChannelFit] | None = None) -> FitResult:
-    """A model that needs the wavelength (:mod:`~roughbrdf.fitting.wavelengths`): each channel
+    """A model that needs the wavelength (:mod:`~roughbrdf.fitting.problem.wavelengths`): each
+    channel
     fitted with the model at that channel's wavelength, the results in one (those ``done``
     kept: each channel is fitted on its own)."""
     if options.joint:

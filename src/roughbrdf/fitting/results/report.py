@@ -2,7 +2,8 @@
 
 One header block for the fit (model, data quantity, what it is compared with, loss, aperture),
 then per channel: success and message, points (and what was left out, with the reasons of
-:data:`roughbrdf.fitting.data.EXCLUSION_REASONS`), variables, starts, model evaluations, chi2,
+:data:`roughbrdf.fitting.problem.data.EXCLUSION_REASONS`), variables, starts, model evaluations,
+chi2,
 reduced chi2, AIC, BIC, TR75's sigma (Eq. 34) and the r.m.s. log residual, the parameters with
 their standard errors, initial values and bounds, the scale ``K``, and the correlations above
 ``min_correl``. ``docs/fitting.md`` shows an example.
@@ -12,12 +13,14 @@ unit named, in radians (the library's unit, ``angles="rad"``, the default) or in
 (``angles="deg"``: what ``roughbrdf fit`` prints and writes to ``report.txt``); ``fit.json``
 always holds radians.
 
-Honest at bounds: a parameter at a bound (:func:`~roughbrdf.fitting.statistics.at_bound`) is
+Honest at bounds: a parameter at a bound (:func:`~roughbrdf.fitting.results.statistics.at_bound`) is
 printed ``(at the lower bound: no stderr) [physical limit]`` or ``(at the upper bound: no
-stderr) [search limit: not a result]`` (:func:`~roughbrdf.fitting.statistics.limit_kinds`) with a
+stderr) [search limit: not a result]`` (:func:`~roughbrdf.fitting.results.statistics.limit_kinds`)
+with a
 note why (the covariance is not meaningful at an active bound); the ``[[Plausibility]]`` block
 gives the albedo by incidence and the model/data peak ratios
-(:mod:`~roughbrdf.fitting.plausibility`); a relative error is printed as a percentage only up
+(:mod:`~roughbrdf.fitting.results.plausibility`); a relative error is printed as a percentage only
+up
 to 1000 % (:func:`percent`); ``# starts`` is the number of local fits run, which is the
 number asked.
 """
@@ -27,9 +30,9 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from ..errors import ArgumentError
-from ..quantity import Loss
-from .data import excluded_text
+from ...errors import ArgumentError
+from ...quantity import Loss
+from ..problem.data import excluded_text
 from .physical import report_lines
 
 if TYPE_CHECKING:
@@ -66,7 +69,7 @@ def report(result: FitResult, *, min_correl: float = 0.1, angles: str = "rad") -
     for i, c in enumerate(result.channels):
         lines += ["", *_channel(c), *_variables(c, angles), *_correlations(c, min_correl),
                   *result.plausibility(i).lines()]
-        # a Mueller fit's channel adds its normalized elements (fitting.polarimetric)
+        # a Mueller fit's channel adds its normalized elements (fitting.kinds.polarimetric)
         lines += getattr(c, "report_lines", list)()
     if result.model_choice is not None:
         choice = result.model_choice
@@ -97,7 +100,7 @@ def _header(result: FitResult) -> list[str]:
 
 
 def _mueller_text(options: dict) -> list[str]:
-    """The line of a Mueller fit (:mod:`~roughbrdf.fitting.polarimetric`), else nothing."""
+    """The line of a Mueller fit (:mod:`~roughbrdf.fitting.kinds.polarimetric`), else nothing."""
     mu = options.get("mueller")
     if not mu:
         return []
@@ -241,7 +244,7 @@ def _variables(c: ChannelFit, angles: str = "rad") -> list[str]:
                       f"is no physical limit:",
                       "     the value is where the search stopped, not a result (widen the "
                       "bounds or change the model)"]
-    lines += report_lines(c)  # a search range beyond the physical one (fitting.physical)
+    lines += report_lines(c)  # a search range beyond the physical one (fitting.results.physical)
     if c.free_scale:
         lines.append(f"    {'scale K':<{width}}: {fmt(c.scale, 7)} +/- "
                      f"{fmt(c.scale_stderr, 4)}{percent(c.scale_stderr, c.scale)} (closed form)")

@@ -28,14 +28,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import ArgumentError
-from ..extrapolation import extrapolated_mask
-from ..instrument import Aperture, InstrumentGeometry
-from ..quantity import Loss, Quantity
+from ...errors import ArgumentError
+from ...extrapolation import extrapolated_mask
+from ...instrument import Aperture, InstrumentGeometry
+from ...quantity import Loss, Quantity
 
 if TYPE_CHECKING:
-    from ..measurement import Measurement
-    from ..models import Model
+    from ...measurement import Measurement
+    from ...models import Model
 
 __all__ = ["Comparison", "ChannelData", "DataOptions", "EXCLUSION_REASONS", "channel_weights",
            "check_fit_domain", "check_relative_to", "check_sample_options", "excluded_text",
@@ -264,7 +264,7 @@ def outside_fit_domain(theta_i: ArrayLike, theta_r: ArrayLike, phi: ArrayLike,
     >>> above.tolist(), near.tolist()
     ([True, False], [False, True])
     """
-    from ..geometry import unit_vectors
+    from ...geometry import unit_vectors
 
     wi, wr = unit_vectors(theta_i, theta_r, phi)
     tr = np.broadcast_to(np.asarray(theta_r, dtype=float), wi.shape[:-1])
@@ -536,7 +536,7 @@ def input_source(meas: Measurement) -> dict[str, str | None]:
         return out
     out["file_abspath"] = out["file_abspath"] or str(path.resolve())
     if not out["file_sha256"]:
-        from ..output import file_sha256
+        from ...output import file_sha256
 
         out["file_sha256"] = file_sha256(path)
     return out

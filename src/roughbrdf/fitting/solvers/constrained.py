@@ -1,9 +1,9 @@
 """Levenberg–Marquardt under box bounds *and* inequality constraints: the energy-constrained refit.
 
 ``docs/fitting.md`` ("Energy constraint"). :func:`constrained_lm` minimizes the cost
-``1/2 |f(x)|^2`` of an :class:`~roughbrdf.fitting.objective.Objective` subject to its bounds
+``1/2 |f(x)|^2`` of an :class:`~roughbrdf.fitting.problem.objective.Objective` subject to its bounds
 and to ``g(x) <= 0`` (:class:`Limits`; for the fits, ``g_k = albedo(theta_k) - target``). It is
-the bounded Levenberg–Marquardt of :mod:`roughbrdf.fitting.bounded` with the constraints
+the bounded Levenberg–Marquardt of :mod:`roughbrdf.fitting.solvers.bounded` with the constraints
 linearized in each step (a Gauss–Newton SQP step, as in the constrained least-squares methods
 of Lawson & Hanson, *Solving Least Squares Problems*, 1974, ch. 23):
 
@@ -11,7 +11,8 @@ of Lawson & Hanson, *Solving Least Squares Problems*, 1974, ch. 23):
     subject to lower <= x + p <= upper,   g(x) + G p <= 0,
 
 ``R``, ``c`` the triangle of the Jacobian and the rotated residuals
-(:class:`~roughbrdf.fitting.bounded.GaussNewtonModel`), ``G`` the constraints' forward-difference
+(:class:`~roughbrdf.fitting.solvers.bounded.GaussNewtonModel`), ``G`` the constraints'
+forward-difference
 Jacobian, ``D`` Marquardt's scaling. The step is solved exactly (:func:`lsi_step`: the problem
 is a *least distance* problem after a change of variables, solved by non-negative least
 squares, Lawson & Hanson's LSI → LDP → NNLS, ch. 23, Algorithm LDP). A step is accepted by the
@@ -35,9 +36,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..interrupts import held_interrupts
+from ...interrupts import held_interrupts
+from ..problem.objective import Objective
 from .bounded import LAMBDA_MAX, BoundedResult, GaussNewtonModel
-from .objective import Objective
 from .stationary import GTOL, edges_of, flat, optimality, scaling, snap
 
 __all__ = ["BAD_LIMIT", "FEASIBLE", "Limits", "constrained_lm", "finite_limits", "lsi_step",
@@ -101,7 +102,7 @@ def lsi_step(model: GaussNewtonModel, damping: np.ndarray, lo: np.ndarray, hi: n
 
     Examples
     --------
-    >>> from roughbrdf.fitting.bounded import GaussNewtonModel
+    >>> from roughbrdf.fitting.solvers.bounded import GaussNewtonModel
     >>> m = GaussNewtonModel.of(np.eye(2), np.array([-2.0, -2.0]))  # optimum p = (2, 2)
     >>> p, mu = lsi_step(m, np.full(2, 1e-12), np.full(2, -5.0), np.full(2, 5.0),
     ...                  np.array([[1.0, 1.0]]), np.array([2.0]))   # p1 + p2 <= 2
@@ -162,14 +163,15 @@ def constrained_lm(obj: Objective, limits: Limits, x0: np.ndarray, tol: float,
                    max_nfev: int | None = None) -> BoundedResult:
     """Minimize ``obj`` within its bounds and ``limits`` from ``x0`` (module notes);
     ``max_nfev`` caps the residual evaluations (default ``100 k``), ``tol`` is the convergence
-    test's fraction of the cost. Status as :class:`~roughbrdf.fitting.bounded.BoundedResult`,
+    test's fraction of the cost. Status as
+    :class:`~roughbrdf.fitting.solvers.bounded.BoundedResult`,
     and 4: the linearized constraints cannot be met within the bounds from the end point.
 
     Examples
     --------
     >>> import roughbrdf as rb
     >>> from roughbrdf.fitting import ChannelData
-    >>> from roughbrdf.fitting.objective import ObjectiveSpec
+    >>> from roughbrdf.fitting.problem.objective import ObjectiveSpec
     >>> spec = ObjectiveSpec(rb.model("lambertian", rho=0.9), ["rho"], [0.0], [1.0],
     ...                      loss="absolute")
     >>> data = ChannelData.from_arrays([0.1, 0.3], [0.2, 0.4], [0.0, 1.0], [0.2, 0.2])
@@ -257,7 +259,7 @@ def _converged(model: GaussNewtonModel, test: tuple[np.ndarray, np.ndarray], jac
     """Why ``x`` is a constrained minimum (module notes), or None: feasible, and the nearly
     undamped step that keeps the linearized constraints predicts no worthwhile decrease, or the
     Lagrangian's projected gradient is first-order optimal
-    (:func:`~roughbrdf.fitting.stationary.optimality`, the test step's multipliers)."""
+    (:func:`~roughbrdf.fitting.solvers.stationary.optimality`, the test step's multipliers)."""
     if violation(g) > FEASIBLE:
         return None
     # the merit's violation part is within FEASIBLE (nearly dependent active constraints can
@@ -274,7 +276,7 @@ def _converged(model: GaussNewtonModel, test: tuple[np.ndarray, np.ndarray], jac
 def _settled(obj: Objective, limits: Limits, x: np.ndarray, cost: float, status: int,
              message: str, nfev: int, njev: int) -> BoundedResult:
     """The result at ``x``, its parameters near a bound tried on it first where the point
-    stays as feasible (:func:`~roughbrdf.fitting.stationary.snap`)."""
+    stays as feasible (:func:`~roughbrdf.fitting.solvers.stationary.snap`)."""
     allowed = max(FEASIBLE, violation(finite_limits(limits.values(x))))
 
     def trial(z: np.ndarray) -> float | None:

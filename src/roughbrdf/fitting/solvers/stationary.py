@@ -21,7 +21,7 @@ the solvers (:mod:`.bounded`, :mod:`.constrained`) do about each:
   :data:`FLAT` of their norm and the constraints by at most ``FEASIBLE``: they do not move.
 * **An end near a bound.** A parameter whose optimum is its bound but whose residuals are
   quadratic in it there (``k -> 0``) approaches it geometrically and stops 1e-5 or 1e-9 from
-  it, so that "at a bound" (:func:`~roughbrdf.fitting.statistics.at_bound`) flips.
+  it, so that "at a bound" (:func:`~roughbrdf.fitting.results.statistics.at_bound`) flips.
   :func:`snap` tries each parameter within :data:`SNAP_DIST` of a bound on the bound and keeps
   it there when the cost rises by at most :data:`SNAP_COST` of itself (a change far below any
   statistical meaning) and the point stays feasible. A bound that is an edge of the
@@ -143,7 +143,7 @@ def optimality(jac: np.ndarray, f: np.ndarray, x: np.ndarray, lower: np.ndarray,
 
 
 def edges_of(spec: Any) -> np.ndarray | None:
-    """``spec.snap_edges()`` (:meth:`~roughbrdf.fitting.objective.ObjectiveSpec.snap_edges`)
+    """``spec.snap_edges()`` (:meth:`~roughbrdf.fitting.problem.objective.ObjectiveSpec.snap_edges`)
     where the solver's objective has it, else None (a duck-typed objective with bounds only:
     ends near a bound alone are tried)."""
     method = getattr(spec, "snap_edges", None)

@@ -26,13 +26,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import ArgumentError
-from ..interrupts import held_interrupts
+from ...interrupts import held_interrupts
+from ..problem.objective import Objective, ObjectiveSpec
+from ..problem.search_options import SearchOptions
 from .bounded import bounded_lm, settle
-from .objective import Objective, ObjectiveSpec
 
 if TYPE_CHECKING:
-    from .data import ChannelData
+    from ..problem.data import ChannelData
 
 __all__ = ["MultiStart", "SearchOptions", "SearchOutcome", "local_fit", "polish_fit",
            "progress_bar", "screen", "sobol_points", "CHOICE_TOL", "EXPLORE_TOL", "POLISH_TOL",
@@ -67,32 +67,6 @@ POLISHED_TIE = 1e-9
 X_SCALE = "jac"
 
 
-@dataclass(frozen=True)
-class SearchOptions:
-    """The search settings of :func:`roughbrdf.fit` (see its parameters)."""
-
-    starts: int = 8
-    screen: int = 64
-    subsample: int | None = 1000
-    polish: int = 2
-    max_nfev: int | None = None
-    seed: int | None = 0
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "starts", _count("starts", self.starts, 1))
-        object.__setattr__(self, "screen", _count("screen", self.screen, 0))
-        object.__setattr__(self, "subsample", _count("subsample", self.subsample, 1, True))
-        object.__setattr__(self, "polish", max(1, _count("polish", self.polish, 0)))
-        object.__setattr__(self, "max_nfev", _count("max_nfev", self.max_nfev, 1, True))
-        if self.seed is not None and not isinstance(self.seed, int | np.integer):
-            raise ArgumentError("seed", f"seed must be None or an integer, got {self.seed!r}")
-
-    @property
-    def n_screen(self) -> int:
-        """Sobol candidates evaluated to choose the ``starts - 1`` Sobol starts."""
-        return max(self.starts - 1, int(self.screen)) if self.starts > 1 else 0
-
-
 @dataclass
 class SearchOutcome:
     """The result of one channel's search.
@@ -116,18 +90,6 @@ class SearchOutcome:
     result: Any
     tried: list[dict[str, Any]] = field(default_factory=list)
     explore_nfev: int = 0
-
-
-def _count(name: str, value: Any, minimum: int, none_ok: bool = False) -> Any:
-    """``value`` as an int ``>= minimum`` (or None where allowed), else an ArgumentError."""
-    if value is None and none_ok:
-        return None
-    ok = isinstance(value, int | np.integer) and not isinstance(value, bool) or (
-        isinstance(value, float) and value.is_integer())
-    if not ok or int(value) < minimum:
-        raise ArgumentError(name, f"{name} must be >= {minimum} (an integer"
-                            f"{', or None' if none_ok else ''}), got {value!r}")
-    return int(value)
 
 
 def sobol_points(lower: np.ndarray, upper: np.ndarray, n: int, seed: Any) -> np.ndarray:
@@ -195,13 +157,14 @@ def polish_fit(obj: Objective, x0: np.ndarray, max_nfev: int | None) -> Any:
 
     Rounds of :data:`POLISH_ROUND` residual evaluations of :func:`local_fit` (``trf``) at
     :data:`POLISH_TOL`; after each round that has not converged, one round of the bounded
-    Levenberg-Marquardt :func:`roughbrdf.fitting.bounded.bounded_lm` from its end point. ``trf``
+    Levenberg-Marquardt :func:`roughbrdf.fitting.solvers.bounded.bounded_lm` from its end point.
+    ``trf``
     keeps the iterates strictly inside the bounds and so creeps towards an optimum on a bound
     (thousands of evaluations on a 14-parameter RB08 paint fit, stopping short of it); the
     bounded steps land on the bound and prove the point a minimum there. The polish ends when
     either converges or ``max_nfev`` residual evaluations are spent in all (default ``100 k``,
     ``least_squares``' own for ``k`` unknowns). Returns the last result
-    (``scipy.optimize.OptimizeResult`` or :class:`roughbrdf.fitting.bounded.BoundedResult`).
+    (``scipy.optimize.OptimizeResult`` or :class:`roughbrdf.fitting.solvers.bounded.BoundedResult`).
     """
     budget = max_nfev if max_nfev is not None else 100 * len(x0)
     used, x = 0, x0

@@ -3,7 +3,7 @@
 ``FitResult`` gives the fitted model as the fit compared it with the data
 (:meth:`FitResult.predict`, through the instrument aperture if the fit had one), the ``fit.json``
 content (:meth:`FitResult.to_dict`, :meth:`FitResult.to_json`), the text report
-(:mod:`roughbrdf.fitting.report`), the plots (:meth:`FitResult.plot`, drawn by
+(:mod:`roughbrdf.fitting.results.report`), the plots (:meth:`FitResult.plot`, drawn by
 :mod:`roughbrdf.plot` through the fit's aperture) and :meth:`FitResult.save`. The keys of
 ``fit.json`` are listed in ``docs/fitting.md`` ("Output files").
 """
@@ -20,19 +20,19 @@ from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..instrument import Aperture, aperture_average
-from ..jsonsafe import clean_json
-from ..quantity import Quantity
-from .data import input_source
+from ...instrument import Aperture, aperture_average
+from ...jsonsafe import clean_json
+from ...quantity import Quantity
+from ..problem.data import input_source
 from .physical import non_physical, physical_range
 from .plausibility import Plausibility, channel_plausibility
 from .statistics import Covariance, GoodnessOfFit, bound_and_undetermined, limit_kinds
 
 if TYPE_CHECKING:
-    from ..measurement import Measurement
-    from ..models import Model
-    from .objective import Objective
-    from .search import SearchOutcome
+    from ...measurement import Measurement
+    from ...models import Model
+    from ..problem.objective import Objective
+    from ..solvers.search import SearchOutcome
 
 __all__ = ["ChannelFit", "FitResult", "channel_model", "check_fit_channels", "fitted_models",
            "input_source", "read_fit_json"]
@@ -61,7 +61,7 @@ class ChannelFit:
         at a bound or undetermined: without effect at the optimum, named in ``message``).
     at_bound : dict
         ``name -> "lower" | "upper"`` for the free parameters at a bound, undetermined ones
-        aside (:func:`~roughbrdf.fitting.statistics.bound_and_undetermined`): no standard
+        aside (:func:`~roughbrdf.fitting.results.statistics.bound_and_undetermined`): no standard
         error nor correlations; the others' covariance is computed with them held there.
         :attr:`limits` tells a physical edge from a search limit.
     correl : dict
@@ -89,7 +89,7 @@ class ChannelFit:
         Model evaluations (each one vectorized over all samples of the stage).
     starts : list of dict
         Every local fit: ``{"x0", "x", "cost", "stage": "explore"|"full"|"single", "origin"}``
-        (:class:`~roughbrdf.fitting.search.SearchOutcome`); the ``stage != "full"`` ones are
+        (:class:`~roughbrdf.fitting.solvers.search.SearchOutcome`); the ``stage != "full"`` ones are
         the ``starts`` asked for, the ``"full"`` ones their polish on all samples.
     elapsed : float
         Seconds.
@@ -135,7 +135,7 @@ class ChannelFit:
     fitted: np.ndarray = field(repr=False)
     residual: np.ndarray = field(repr=False)
     at_bound: dict[str, str] = field(default_factory=dict)
-    #: the :class:`~roughbrdf.fitting.plausibility.Plausibility` (:meth:`FitResult.plausibility`)
+    #: the :class:`~.plausibility.Plausibility` (:meth:`FitResult.plausibility`)
     plausibility: Plausibility | None = field(default=None, repr=False)
     #: what the energy constraint did (:class:`~roughbrdf.fitting.energy.EnergyConstraint`)
     energy_constraint: Any = field(default=None, repr=False)
@@ -143,7 +143,7 @@ class ChannelFit:
     @property
     def limits(self) -> dict[str, str]:
         """``{name: "physical-lower" | "search-upper" ...}`` of the parameters :attr:`at_bound`
-        (:func:`~roughbrdf.fitting.statistics.limit_kinds`)."""
+        (:func:`~roughbrdf.fitting.results.statistics.limit_kinds`)."""
         return limit_kinds(self.at_bound, self.bounds, self.model.parameters,
                            {nm: physical_range(self.model, nm) for nm in self.bounds})
 
@@ -157,7 +157,7 @@ class ChannelFit:
     @classmethod
     def from_search(cls, obj: Objective, outcome: SearchOutcome, elapsed: float) -> ChannelFit:
         """The channel's result at the search's optimum: statistics on all samples of ``obj``
-        (:mod:`~roughbrdf.fitting.statistics`)."""
+        (:mod:`~roughbrdf.fitting.results.statistics`)."""
         f = obj.values(outcome.theta)
         return cls(**cls.fields_at_optimum(obj, outcome, elapsed, f, obj.data.values, f))
 
@@ -238,7 +238,7 @@ class FitResult:
     #: the input file as it was when the fit ran: ``{"file", "file_abspath", "file_sha256"}``
     #: (:func:`input_source`; None: taken from the measurement when needed)
     source: dict[str, str | None] | None = field(default=None, repr=False)
-    #: with ``rb.fit("auto", ...)``: the :class:`~roughbrdf.fitting.compare.ModelComparison`
+    #: with ``rb.fit("auto", ...)``: the :class:`~roughbrdf.fitting.choice.compare.ModelComparison`
     #: of the candidates this fit was chosen from (``fit.json``'s ``model_choice``)
     model_choice: Any = field(default=None, repr=False)
 
@@ -294,7 +294,7 @@ class FitResult:
         return any(self.plausibility(i).gains_energy for i in range(len(self.channels)))
 
     def plausibility(self, channel: int | str = 0) -> Plausibility:
-        """The albedo and peak ratios of a channel (:mod:`~roughbrdf.fitting.plausibility`),
+        """The albedo and peak ratios of a channel (:mod:`~roughbrdf.fitting.results.plausibility`),
         computed once."""
         c = self[channel]
         if c.plausibility is None:
@@ -364,14 +364,14 @@ class FitResult:
         replaced only with ``overwrite=True``, else ``FileExistsError``)."""
         text = json.dumps(self.to_dict(), indent=indent, allow_nan=False)
         if path is not None:
-            from ..output import atomic_write
+            from ...output import atomic_write
 
             atomic_write(path, text + "\n", overwrite=overwrite)
         return text
 
     def report(self, *, min_correl: float = 0.1, angles: str = "rad") -> str:
-        """lmfit-style text report of every channel (:func:`roughbrdf.fitting.report.report`);
-        parameters whose unit is an angle in ``angles`` (``"rad"`` or ``"deg"``)."""
+        """lmfit-style text report of every channel (:func:`~.report.report`); parameters
+        whose unit is an angle in ``angles`` (``"rad"`` or ``"deg"``)."""
         from .report import report
 
         return report(self, min_correl=min_correl, angles=angles)
@@ -381,7 +381,7 @@ class FitResult:
 
     def _repr_html_(self) -> str:
         """Jupyter's rich display (:func:`roughbrdf.html_repr.fit_html`)."""
-        from ..html_repr import fit_html
+        from ...html_repr import fit_html
 
         return fit_html(self)
 
@@ -403,8 +403,8 @@ class FitResult:
         samples the fit left out (:func:`roughbrdf.plot_fit.plot_fit`, the fit's aperture: the
         model drawn as the fit compared it). Returns ``(fig, (ax_comparison,
         ax_residuals))``; a new figure is a pyplot-free :class:`matplotlib.figure.Figure`."""
-        from ..plot_fit import plot_fit
-        from .data import excluded_text
+        from ...plot_fit import plot_fit
+        from ..problem.data import excluded_text
 
         model, meas = self.plot_data(channel)
         c = self[channel]
@@ -443,7 +443,7 @@ class FitResult:
         list of pathlib.Path
             The paths written: ``fit.json``, ``report.txt``, then the PNGs.
         """
-        from ..output import ResultFolder
+        from ...output import ResultFolder
 
         files = self.files(plots=plots, dpi=dpi, report_angles=report_angles)
         with ResultFolder(out_dir, overwrite=overwrite) as out:
@@ -580,8 +580,8 @@ def _channels_problem(chans: Any) -> str:
 def channel_model(fit: dict[str, Any], chan: dict[str, Any]) -> Model:
     """The fitted model of one channel entry of ``fit.json`` (its ``model_spec``; a fit.json
     of an older roughbrdf: the model's name and the channel's ``params``)."""
-    from ..models import model as make_model
-    from ..models.coated import legacy_spec  # coated ks of roughbrdf 0.1.0: weights="free"
+    from ...models import model as make_model
+    from ...models.coated import legacy_spec  # coated ks of roughbrdf 0.1.0: weights="free"
 
     spec = chan.get("model_spec")
     if not isinstance(spec, dict):  # an older fit.json: the model's name and the params
@@ -593,7 +593,7 @@ def channel_model(fit: dict[str, Any], chan: dict[str, Any]) -> Model:
 
 def fitted_models(fit: str | os.PathLike) -> dict[str, Model]:
     """``{channel: model}`` of a saved fit (``fit.json`` or its folder), checked as load_fit's."""
-    from ..result_check import check_result_folder
+    from ...result_check import check_result_folder
 
     check_result_folder(fit if Path(fit).is_dir() else Path(fit).parent)
     content, _ = read_fit_json(fit)

@@ -17,7 +17,7 @@ and statistics").
   ``tests/fitting/test_fit_coverage.py``). Where the residuals are homoscedastic the two agree.
   ``stderr = sqrt(diag(covar))``, ``correl`` is ``covar`` normalized. A singular ``J^T J``
   gives NaN and a note for the message; joint fits
-  (:mod:`~roughbrdf.fitting.joint`) keep the classical form;
+  (:mod:`~roughbrdf.fitting.kinds.joint`) keep the classical form;
 * :func:`at_bound` -- the parameters at (or within :data:`AT_BOUND_RTOL` of the width of their
   bounds from) a bound. They get no standard error: the covariance describes the cost as a
   quadratic bowl around an interior optimum, which an active bound is not (the optimum there is
@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
-    from .objective import Objective
+    from ..problem.objective import Objective
 
 __all__ = ["AT_BOUND_RTOL", "Covariance", "GoodnessOfFit", "at_bound", "bound_and_undetermined",
            "limit_kinds", "rms_log", "tr75_sigma"]
@@ -90,13 +90,14 @@ def bound_and_undetermined(obj: Objective, theta: np.ndarray, k: float, r: np.nd
     ``obj`` (scale ``k``, residuals ``r``), with the central-difference Jacobian there.
 
     Undetermined: a parameter without effect at the optimum
-    (:func:`~roughbrdf.fitting.stationary.flat`: a lobe's width at weight 0, TR75's ``e`` when
+    (:func:`~roughbrdf.fitting.solvers.stationary.flat`: a lobe's width at weight 0, TR75's ``e``
+    when
     ``n = 1`` turns its lobe off). Where it stopped is any value, so it is not "at a bound"
     even where it stopped on one (two machines' rounding left it on a bound or not), and it
     is held in the covariance as the parameters at a bound are: the others keep their
     standard errors (with it, ``J^T J`` is singular and none would have one).
     """
-    from .stationary import flat
+    from ..solvers.stationary import flat
 
     spec = obj.spec
     jac = obj.jac_central(theta, k)
@@ -118,7 +119,7 @@ def limit_kinds(at: Mapping[str, str], bounds: Mapping[str, tuple[float, float]]
     :class:`~roughbrdf.models.parameters.Parameter` objects. A bound is physical when it is the
     parameter's domain edge on that side (to 1e-9 relative), or the edge of its ``physical``
     range (``name -> (low, high)``: microfacet ``ks = 1``, the most one interface reflects,
-    :func:`roughbrdf.fitting.physical.physical_range`), else a search limit. A name with no
+    :func:`roughbrdf.fitting.results.physical.physical_range`), else a search limit. A name with no
     parameter of that name (a joint fit's ``name[channel]``) is looked up by its stem.
 
     Examples

@@ -1,8 +1,8 @@
-"""``--model auto``: the candidates of :func:`~roughbrdf.fitting.compare.compare`, the best
+"""``--model auto``: the candidates of :func:`~roughbrdf.fitting.choice.compare.compare`, the best
 kept, with a candidate far behind skipped after the first channel.
 
 :func:`fit_auto` (``rb.fit("auto", ...)``) ranks the candidates as
-:func:`~roughbrdf.fitting.compare.compare` does (by the leave-one-incidence-out score; BIC
+:func:`~roughbrdf.fitting.choice.compare.compare` does (by the leave-one-incidence-out score; BIC
 without one) and returns the best fit with the comparison attached. With the score, several
 channels and at least two candidates, it works in two stages (``docs/fitting.md``, "Model
 choice"):
@@ -11,7 +11,7 @@ choice"):
 2. a candidate whose first-channel score is more than :data:`SKIP_MARGIN` above the best
    first-channel score (of the candidates whose fit does not gain energy) is not fitted
    further: its row keeps the first channel's figures and says so
-   (:attr:`~roughbrdf.fitting.compare.Candidate.partial`), and it ranks after every whole
+   (:attr:`~roughbrdf.fitting.choice.compare.Candidate.partial`), and it ranks after every whole
    candidate. The others are fitted to the remaining channels, the search going on from the
    first channel as in one whole fit (the same subsample draws, the first channel's optimum as
    the warm start: the fit is the one ``compare`` makes), and scored over all channels as
@@ -33,9 +33,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import ArgumentError
-from ..models import Model, spec_text
-from .channels import fit_model, is_mueller
+from ...errors import ArgumentError
+from ...models import Model, spec_text
+from ..kinds.channels import fit_model, is_mueller
+from ..problem.options import FitOptions
+from ..problem.plan import channel_indices
+from ..results.plausibility import ENERGY_TOLERANCE, EnergyWarning, warn_energy
 from .compare import (
     Candidate,
     as_candidates,
@@ -46,13 +49,10 @@ from .compare import (
     rms,
     score_metric,
 )
-from .options import FitOptions
-from .plan import channel_indices
-from .plausibility import ENERGY_TOLERANCE, EnergyWarning, warn_energy
 
 if TYPE_CHECKING:
-    from ..measurement import Measurement
-    from .result import FitResult
+    from ...measurement import Measurement
+    from ..results.result import FitResult
 
 __all__ = ["fit_auto", "SKIP_MARGIN"]
 
@@ -67,9 +67,9 @@ def fit_auto(measurement: Measurement, candidates: Sequence[Model | str] | str |
              **keywords: Any) -> FitResult:
     """``rb.fit("auto", ...)``: the candidates compared (module notes), the best returned
     (by the cross-validation score, BIC without one;
-    :func:`~roughbrdf.fitting.compare.rank`), with the comparison attached
+    :func:`~roughbrdf.fitting.choice.compare.rank`), with the comparison attached
     (``FitResult.model_choice``: in ``fit.json``, the report and ``compare.png``).
-    ``options`` and ``keywords`` as for :func:`~roughbrdf.fitting.compare.compare`; ``fix``
+    ``options`` and ``keywords`` as for :func:`~roughbrdf.fitting.choice.compare.compare`; ``fix``
     and ``bounds`` are refused (ArgumentError)."""
     if options is None:  # a progress bar per candidate only when asked for
         keywords = {"progress": False, **keywords}
@@ -107,7 +107,7 @@ def _staged(measurement: Measurement, options: FitOptions, cv: bool,
 
 
 def _in_two_stages(measurement: Measurement, models: list[Model], options: FitOptions) -> Any:
-    """The :class:`~roughbrdf.fitting.compare.ModelComparison` of the two stages (module
+    """The :class:`~roughbrdf.fitting.choice.compare.ModelComparison` of the two stages (module
     notes)."""
     metric, losses = score_metric(models, options)
     first, *rest = channel_indices(measurement, options.channel)

@@ -12,9 +12,9 @@ are relative). By default the per-channel parameters are the reflectances (param
 ``"reflectance"``, :mod:`roughbrdf.models.parameters`) and every other free parameter is
 shared; ``shared=`` names them explicitly.
 
-:class:`JointObjective` has the interface of :class:`~roughbrdf.fitting.objective.Objective`
+:class:`JointObjective` has the interface of :class:`~roughbrdf.fitting.problem.objective.Objective`
 that the search uses (``fun``, ``jac``, ``cost``, ``spec.lower``/``upper``), so the same
-screening, multistart and polish (:mod:`~roughbrdf.fitting.search`) run on it. The standard
+screening, multistart and polish (:mod:`~roughbrdf.fitting.solvers.search`) run on it. The standard
 errors come from the joint Jacobian (the shared parameters are constrained by every channel).
 """
 
@@ -27,15 +27,15 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import ArgumentError
-from .objective import Objective, ObjectiveSpec
-from .result import ChannelFit
-from .search import SearchOptions, SearchOutcome, screen, search, sobol_points
-from .statistics import Covariance, at_bound
+from ...errors import ArgumentError
+from ..problem.objective import Objective, ObjectiveSpec
+from ..results.result import ChannelFit
+from ..results.statistics import Covariance, at_bound
+from ..solvers.search import SearchOptions, SearchOutcome, screen, search, sobol_points
 
 if TYPE_CHECKING:
-    from ..models import Model
-    from .data import ChannelData
+    from ...models import Model
+    from ..problem.data import ChannelData
 
 __all__ = ["JointLayout", "JointObjective", "default_shared", "fit_joint"]
 
@@ -153,7 +153,7 @@ class JointObjective:
     def covariance(self, theta: np.ndarray, held: Sequence[str]) -> Covariance:
         """From the central-difference joint Jacobian at ``theta`` (scales at their optimum;
         parameters in ``held``, at a bound, get NaN, as in
-        :meth:`~roughbrdf.fitting.statistics.Covariance.at_optimum`)."""
+        :meth:`~roughbrdf.fitting.results.statistics.Covariance.at_optimum`)."""
         names = list(self.spec.free)
         keep = [j for j, nm in enumerate(names) if nm not in held]
         blocks, chi2 = [], 0.0
@@ -211,9 +211,9 @@ def fit_joint(spec: ObjectiveSpec, data: Sequence[ChannelData], options: SearchO
     """Fit every channel of ``data`` at once (module notes); one :class:`ChannelFit` each,
     and the joint figures (``fit.json``'s ``options.joint``): ``shared``, ``n_varys``,
     ``n_points``, ``chi2``, ``aic``, ``bic`` of all channels together (one residual variance
-    per channel: the definition of :func:`roughbrdf.fitting.compare.information`).
+    per channel: the definition of :func:`roughbrdf.fitting.choice.compare.information`).
 
-    The search is the one of a single channel (:func:`~roughbrdf.fitting.search.search`):
+    The search is the one of a single channel (:func:`~roughbrdf.fitting.solvers.search.search`):
     exactly ``options.starts`` local fits, from the model's values and from screened Sobol
     points of the joint box. Each channel's entry reports its own figures of merit; ``free``,
     ``stderr`` and ``correl`` are of the joint unknowns it depends on (shared ones under their
@@ -237,7 +237,7 @@ def fit_joint(spec: ObjectiveSpec, data: Sequence[ChannelData], options: SearchO
     fits = [_channel_fit(full, c, outcome, cov, bound, elapsed) for c in range(len(data))]
     chi2 = sum(f.chi2 for f in fits)
     k, n = layout.n_varys, full.n
-    # one residual variance per channel, as roughbrdf.fitting.compare.information counts it
+    # one residual variance per channel, as roughbrdf.fitting.choice.compare.information counts it
     like = sum(f.n_points * math.log(f.chi2 / f.n_points) if f.chi2 > 0 else -math.inf
                for f in fits)
     summary = {"shared": list(layout.shared), "n_varys": k, "n_points": n, "chi2": chi2,

@@ -1,5 +1,6 @@
 """The plan of one fit: what :func:`roughbrdf.fit` does with its model, measurement and
-:class:`~roughbrdf.fitting.options.FitOptions`, checked before any work (``docs/fitting.md``).
+:class:`~roughbrdf.fitting.problem.options.FitOptions`, checked before any work
+(``docs/fitting.md``).
 
 :class:`FitPlan` holds the data options, the search, the free parameters and their bounds
 (:class:`FreeParameters`), the objective and the data scale ``K`` (free for relative data,
@@ -18,16 +19,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import ArgumentError
-from ..instrument import Aperture
-from ..measurement import Measurement
-from ..models import Model, Parameter
-from ..models.factory import as_model, model_label
-from ..quantity import Quantity
+from ...errors import ArgumentError
+from ...instrument import Aperture
+from ...measurement import Measurement
+from ...models import Model, Parameter
+from ...models.factory import as_model, model_label
+from ...quantity import Quantity
 from .data import ChannelData, Comparison, DataOptions, input_source, negative_rule, where
 from .objective import ObjectiveSpec
 from .options import check_scale, default_loss
-from .search import SearchOptions
+from .search_options import SearchOptions
 
 if TYPE_CHECKING:
     from .options import FitOptions
@@ -95,7 +96,7 @@ class FreeParameters:
 
     def spec(self, model: Model, *, loss: str, quantity: Quantity | str, free_scale: bool,
              fixed_scale: float) -> ObjectiveSpec:
-        """The :class:`~roughbrdf.fitting.objective.ObjectiveSpec` of these parameters."""
+        """The :class:`~roughbrdf.fitting.problem.objective.ObjectiveSpec` of these parameters."""
         return ObjectiveSpec(model, self.names, self.lower, self.upper, loss=loss,
                              quantity=quantity, free_scale=free_scale, fixed_scale=fixed_scale)
 
@@ -207,7 +208,8 @@ def check_enough_data(meas: Measurement, data: Sequence[ChannelData], n_varys: i
 class FitPlan:
     """What one call of :func:`roughbrdf.fit` (or its Mueller form) does, checked before any
     work: the data options, the search, the free parameters and their
-    :class:`~roughbrdf.fitting.objective.ObjectiveSpec`, and the ``options`` of ``fit.json``."""
+    :class:`~roughbrdf.fitting.problem.objective.ObjectiveSpec`, and the ``options`` of
+    ``fit.json``."""
 
     model: Model
     opts: DataOptions
@@ -248,7 +250,7 @@ class FitPlan:
 
     def result_fields(self, measurement: Measurement, elapsed: float,
                       **options: Any) -> dict[str, Any]:
-        """The fields of a :class:`~roughbrdf.fitting.result.FitResult` of this plan besides
+        """The fields of a :class:`~roughbrdf.fitting.results.result.FitResult` of this plan besides
         its channels; ``options`` adds to (or sets) the recorded ``options``."""
         ap = self.opts.aperture
         return {"measurement": measurement, "model_name": model_label(self.model),

@@ -49,18 +49,18 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import ArgumentError
-from ..models import Model, from_spec, spec_text
-from ..models.factory import split_specs
-from ..quantity import Loss
-from .channels import fit_model
-from .options import FitOptions, default_loss
-from .plausibility import ENERGY_TOLERANCE
-from .search import progress_bar
+from ...errors import ArgumentError
+from ...models import Model, from_spec, spec_text
+from ...models.factory import split_specs
+from ...quantity import Loss
+from ..kinds.channels import fit_model
+from ..problem.options import FitOptions, default_loss
+from ..results.plausibility import ENERGY_TOLERANCE
+from ..solvers.search import progress_bar
 
 if TYPE_CHECKING:
-    from ..measurement import Measurement
-    from .result import FitResult
+    from ...measurement import Measurement
+    from ..results.result import FitResult
 
 __all__ = ["AUTO_CANDIDATES", "THETA_R_BANDS", "Candidate", "ModelComparison", "choice_notes",
            "candidate", "compare", "comparison", "cross_validate", "held_out_residuals",
@@ -121,7 +121,7 @@ class Candidate:
     cv: float | None = None
     elapsed: float = math.nan
     #: why the candidate was fitted on part of the channels only (``--model auto`` skips a
-    #: candidate far behind after the first channel: :mod:`~roughbrdf.fitting.auto`); None
+    #: candidate far behind after the first channel: :mod:`~roughbrdf.fitting.choice.auto`); None
     #: for a whole fit
     partial: str | None = None
 
@@ -310,7 +310,7 @@ def band_rms_log(result: FitResult) -> dict[str, float]:
 def cross_validate(result: FitResult, options: FitOptions | Mapping[str, Any], *,
                    label: str | None = None, metric: str | None = None) -> float:
     """Leave-one-incidence-out score of a fit made with ``options`` (a
-    :class:`~roughbrdf.fitting.options.FitOptions` or its fields by name; module notes); NaN
+    :class:`~roughbrdf.fitting.problem.options.FitOptions` or its fields by name; module notes); NaN
     with a single incidence. The held-out residuals are the fit's loss's, or with
     ``metric="log"`` ``ln(K x) - ln f`` (one yardstick for candidates fitted with different
     losses, :func:`compare`). A progress bar (``options.progress``) names the candidate
@@ -433,7 +433,8 @@ def compare(measurement: Measurement, candidates: Sequence[Model | str] | str | 
         Compute the leave-one-incidence-out score (one local refit per candidate, channel
         group and incidence).
     options : FitOptions, optional
-        The options of every candidate's fit (:class:`~roughbrdf.fitting.options.FitOptions`).
+        The options of every candidate's fit
+        (:class:`~roughbrdf.fitting.problem.options.FitOptions`).
     **keywords
         Options as keywords (``loss``, ``channel``, ``joint``, ``aperture``, ``theta_r_max``,
         ...), replacing those of ``options``; given as keywords, ``progress`` is False unless

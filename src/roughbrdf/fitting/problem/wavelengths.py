@@ -11,20 +11,20 @@ evaluated; a fit gives each channel's model the wavelength of that channel, from
 
 Without any of them the fit is refused with an :class:`~roughbrdf.errors.ArgumentError`
 naming ``wavelength``. Channels of different wavelengths are fitted one by one, each with its
-model (:func:`roughbrdf.fitting.channels.fit_model`).
+model (:func:`roughbrdf.fitting.kinds.channels.fit_model`).
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from ..errors import ArgumentError
-from ..models.base import SumModel, components
-from ..models.kcorr import parse_wavelength
+from ...errors import ArgumentError
+from ...models.base import SumModel, components
+from ...models.kcorr import parse_wavelength
 
 if TYPE_CHECKING:
-    from ..measurement import Measurement
-    from ..models import Model
+    from ...measurement import Measurement
+    from ...models import Model
 
 __all__ = ["channel_wavelength", "needs_wavelength", "with_wavelength"]
 

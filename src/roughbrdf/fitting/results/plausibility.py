@@ -28,10 +28,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import ArgumentError
+from ...errors import ArgumentError
 
 if TYPE_CHECKING:
-    from ..models import Model
+    from ...models import Model
     from .result import ChannelFit, FitResult
 
 __all__ = ["ALBEDO_INCIDENCES_DEG", "ENERGY_TOLERANCE", "EXPORT_INCIDENCES_DEG", "EnergyWarning",
@@ -54,7 +54,7 @@ class EnergyWarning(UserWarning):
 def albedo_by_incidence(model: Model, theta_deg: Sequence[float] = ALBEDO_INCIDENCES_DEG
                         ) -> np.ndarray:
     """:func:`roughbrdf.albedo` of ``model`` at the incidences ``theta_deg`` (degrees)."""
-    from ..integrate import albedo
+    from ...integrate import albedo
 
     return np.atleast_1d(np.asarray(albedo(model, np.radians(np.asarray(theta_deg, float))),
                                     dtype=float))

@@ -28,14 +28,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import ArgumentError
+from ...errors import ArgumentError
+from ..problem.options import FitOptions
 from .channels import fit_model
-from .options import FitOptions
 
 if TYPE_CHECKING:
-    from ..measurement import Measurement
-    from ..models import Model
-    from .result import FitResult
+    from ...measurement import Measurement
+    from ...models import Model
+    from ..results.result import FitResult
 
 __all__ = ["MAX_ROWS", "IncidenceRow", "PerIncidenceFit", "choose_rows", "fit_per_incidence",
            "interpolate_params"]
@@ -133,8 +133,8 @@ class PerIncidenceFit:
         """Write ``fit.json`` (:meth:`to_dict`, with the measurement's file) and ``report.txt``
         (:meth:`report`) into ``out_dir`` as one set (:class:`roughbrdf.output.ResultFolder`:
         an earlier run's results or a file of those names refused unless ``overwrite``)."""
-        from ..output import ResultFolder
-        from .data import input_source
+        from ...output import ResultFolder
+        from ..problem.data import input_source
 
         doc = {**self.to_dict(), **input_source(self.rows[0].result.measurement)}
         files = {"fit.json": json.dumps(doc, indent=2, default=float) + "\n",
@@ -200,7 +200,7 @@ def _errors(rows: list[IncidenceRow], chosen: list[int], meas: Measurement,
             channel: str) -> tuple[float, float]:
     """(worst relative TIS error, rms-log) of the rows ``chosen`` interpolated, at every
     measured incidence of ``channel`` (on the samples each incidence's fit used)."""
-    from ..integrate import albedo
+    from ...integrate import albedo
 
     kept = [rows[k] for k in chosen]
     theta = [r.theta_i for r in kept]
@@ -264,8 +264,8 @@ def fit_per_incidence(model: Model | str, measurement: Measurement, *, max_rows:
     >>> [round(r.params("value")["rho"], 6) for r in res.rows], res.chosen
     ([0.4, 0.4], [0, 1])
     """
-    from ..integrate import albedo
-    from ..models.factory import as_model, is_auto
+    from ...integrate import albedo
+    from ...models.factory import as_model, is_auto
 
     if isinstance(model, str) and is_auto(model):
         raise ArgumentError("model", "a per-incidence fit holds one model: name it", value=model)

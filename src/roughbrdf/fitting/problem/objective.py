@@ -35,10 +35,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..quantity import F_FLOOR, Loss, Quantity, relative_scale
+from ...quantity import F_FLOOR, Loss, Quantity, relative_scale
 
 if TYPE_CHECKING:
-    from ..models import Model
+    from ...models import Model
     from .data import ChannelData
 
 __all__ = ["Objective", "ObjectiveSpec", "BAD_RESIDUAL", "F_FLOOR"]
@@ -108,8 +108,8 @@ class ObjectiveSpec:
         """``(p, 2)`` booleans: whether each free parameter's lower and upper bound is an
         edge of its physical domain (:attr:`Parameter.domain
         <roughbrdf.models.parameters.Parameter.domain>`, to 1e-9: a lobe's weight 0 or 1,
-        ``k = 0``), as :func:`~roughbrdf.fitting.statistics.limit_kinds` tells them: where
-        :func:`~roughbrdf.fitting.stationary.snap` tries an end from any distance. None with
+        ``k = 0``), as :func:`~roughbrdf.fitting.results.statistics.limit_kinds` tells them: where
+        :func:`~roughbrdf.fitting.solvers.stationary.snap` tries an end from any distance. None with
         a free scale: a parameter that is one degree of freedom with it (TS67's ``rho_d``) is
         as good on its edge, but that value would be no result.
 
@@ -191,7 +191,7 @@ class Objective:
     """Residuals of one channel (or a subsample of it) as a function of the free parameters.
 
     Built from an :class:`ObjectiveSpec` and the channel's
-    :class:`~roughbrdf.fitting.data.ChannelData`; :meth:`fun` and :meth:`jac` are what
+    :class:`~roughbrdf.fitting.problem.data.ChannelData`; :meth:`fun` and :meth:`jac` are what
     ``scipy.optimize.least_squares`` calls. ``nfev`` counts model evaluations (each one
     vectorized over all samples).
 

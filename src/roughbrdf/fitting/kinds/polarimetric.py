@@ -4,7 +4,7 @@ A :class:`~roughbrdf.measurement.Measurement` whose channels are Mueller element
 (``measurement.mueller`` set) is fitted with all its elements at once, as TR75 constrained the
 index with polarized data. The residuals of one sample are
 
-* ``m00``: the usual loss of :mod:`~roughbrdf.fitting.objective` (``relative`` by default,
+* ``m00``: the usual loss of :mod:`~roughbrdf.fitting.problem.objective` (``relative`` by default,
   ``w (K x - f)/f``) on the unpolarized BRDF, with the data scale ``K`` of relative data;
 * every other element held: the **absolute** difference of the normalized elements,
   ``w_p w_ij (M_ij/M_00 - m_ij/m00)``, ``M`` the model's Mueller matrix
@@ -17,10 +17,11 @@ the uncertainty of ``m_ij/m00``). Normalized elements do not depend on ``K`` nor
 absolute calibration of the data: with relative data they still fix the index.
 
 :func:`fit_mueller` is what :func:`roughbrdf.fit` runs for such a measurement. It reuses the
-whole single-channel machinery: :func:`~roughbrdf.fitting.data.prepare_channel` on ``m00``
-(what is left out, and why), the global search (:class:`~roughbrdf.fitting.search.MultiStart`
+whole single-channel machinery: :func:`~roughbrdf.fitting.problem.data.prepare_channel` on ``m00``
+(what is left out, and why), the global search
+(:class:`~roughbrdf.fitting.solvers.search.MultiStart`
 with a :class:`MuellerObjective`), the covariance and the figures of merit
-(:mod:`~roughbrdf.fitting.statistics`, on all residuals). The result is a
+(:mod:`~roughbrdf.fitting.results.statistics`, on all residuals). The result is a
 :class:`MuellerFitResult` with one :class:`MuellerChannelFit` labelled ``"mueller"``.
 """
 
@@ -35,21 +36,21 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import ArgumentError
-from ..instrument import InstrumentGeometry
-from ..measurement import MUELLER_ELEMENTS, Measurement
-from ..models.factory import as_model, is_auto, model_label
-from ..quantity import Quantity
-from .data import DataOptions, prepare_channel, where
-from .objective import BAD_RESIDUAL, Objective, ObjectiveSpec
-from .options import FitOptions, check_polarimetric_weight
-from .plan import FitPlan, check_enough_data
-from .result import ChannelFit, FitResult
-from .search import MultiStart, SearchOptions, SearchOutcome, progress_bar
-from .threads import single_thread_blas
+from ...errors import ArgumentError
+from ...instrument import InstrumentGeometry
+from ...measurement import MUELLER_ELEMENTS, Measurement
+from ...models.factory import as_model, is_auto, model_label
+from ...quantity import Quantity
+from ..problem.data import DataOptions, prepare_channel, where
+from ..problem.objective import BAD_RESIDUAL, Objective, ObjectiveSpec
+from ..problem.options import FitOptions, check_polarimetric_weight
+from ..problem.plan import FitPlan, check_enough_data
+from ..results.result import ChannelFit, FitResult
+from ..solvers.search import MultiStart, SearchOptions, SearchOutcome, progress_bar
+from ..solvers.threads import single_thread_blas
 
 if TYPE_CHECKING:
-    from ..models import Model
+    from ...models import Model
 
 __all__ = ["MuellerData", "MuellerObjective", "MuellerChannelFit", "MuellerFitResult",
            "fit_mueller", "prepare_mueller", "check_polarimetric_weight", "POLARIMETRIC_WEIGHT"]
@@ -81,7 +82,7 @@ class MuellerData:
     basis : str
         Polarization basis of the elements (:meth:`roughbrdf.models.Model.mueller`).
     label, index, excluded
-        As :class:`~roughbrdf.fitting.data.ChannelData`.
+        As :class:`~roughbrdf.fitting.problem.data.ChannelData`.
     """
 
     m00: np.ndarray
@@ -177,7 +178,7 @@ def _unusable_rows(meas: Measurement, norm: np.ndarray, opts: DataOptions, place
 def prepare_mueller(model: Model, meas: Measurement, opts: DataOptions) -> MuellerData:
     """The samples of a Mueller measurement that enter the fit of ``model``.
 
-    ``m00`` goes through :func:`~roughbrdf.fitting.data.prepare_channel` (every rule of an
+    ``m00`` goes through :func:`~roughbrdf.fitting.problem.data.prepare_channel` (every rule of an
     ordinary channel: extrapolated, non-finite and negative values, weights, fit domain, model
     domain); before that, samples with ``m00 <= 0`` or a non-finite element are left out
     (counted as ``negative`` and ``nonfinite``) when ``negative="drop"`` /
@@ -230,7 +231,7 @@ class MuellerObjective(Objective):
 
     :meth:`values` returns the model's flattened Mueller matrices, shape (N, 16); the
     Jacobians, the scale and the search are those of
-    :class:`~roughbrdf.fitting.objective.Objective`.
+    :class:`~roughbrdf.fitting.problem.objective.Objective`.
     """
 
     data: MuellerData  # type: ignore[assignment]
@@ -283,7 +284,7 @@ class MuellerObjective(Objective):
 
 
 class _MuellerSearch(MultiStart):
-    """:class:`~roughbrdf.fitting.search.MultiStart` on :class:`MuellerObjective`."""
+    """:class:`~roughbrdf.fitting.solvers.search.MultiStart` on :class:`MuellerObjective`."""
 
     def __init__(self, spec: ObjectiveSpec, options: SearchOptions, weight: float,
                  on_start: Any = None) -> None:
@@ -304,7 +305,7 @@ class _MuellerSearch(MultiStart):
 # --------------------------------------------------------------------------------------------
 @dataclass
 class MuellerChannelFit(ChannelFit):
-    """The fit of a Mueller measurement: a :class:`~roughbrdf.fitting.result.ChannelFit`
+    """The fit of a Mueller measurement: a :class:`~roughbrdf.fitting.results.result.ChannelFit`
     (``data``/``fitted``: ``m00``; ``sigma``, ``rms_log``: of ``m00``; ``chi2``, AIC, BIC and
     the covariance: of all residuals) with the normalized elements.
 
@@ -370,7 +371,8 @@ class MuellerChannelFit(ChannelFit):
         return out
 
     def report_lines(self) -> list[str]:
-        """The report's ``[[Mueller elements]]`` block (:mod:`~roughbrdf.fitting.report`)."""
+        """The report's ``[[Mueller elements]]`` block
+        (:mod:`~roughbrdf.fitting.results.report`)."""
         rms = ", ".join(f"{nm} {v:.3g}" for nm, v in self.rms_normalized.items()
                         if nm != "all")
         return ["[[Mueller elements]] (normalized, basis "
@@ -383,7 +385,7 @@ class MuellerChannelFit(ChannelFit):
 
 @dataclass
 class MuellerFitResult(FitResult):
-    """:class:`~roughbrdf.fitting.result.FitResult` of a Mueller fit: one
+    """:class:`~roughbrdf.fitting.results.result.FitResult` of a Mueller fit: one
     :class:`MuellerChannelFit` labelled ``"mueller"``; plots show ``m00``
     (:meth:`plot_data`)."""
 
@@ -426,7 +428,8 @@ def fit_mueller(model: Model | str, measurement: Measurement, *,
     """Fit ``model`` to the Mueller elements of ``measurement`` (module notes).
 
     The options are those of :func:`roughbrdf.fit` (which calls this for a measurement with
-    Mueller data): a :class:`~roughbrdf.fitting.options.FitOptions` or its fields as keywords;
+    Mueller data): a :class:`~roughbrdf.fitting.problem.options.FitOptions` or its fields as
+    keywords;
     ``polarimetric_weight`` is ``w_p`` (finite and >= 0; None: :data:`POLARIMETRIC_WEIGHT`).
     ``loss`` applies to ``m00``; the normalized elements always take the absolute difference.
     Samples with ``m00 <= 0`` are left out with ``negative="drop"`` and raise otherwise;

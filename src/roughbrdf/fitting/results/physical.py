@@ -23,7 +23,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from ..models.base import Model, SumModel
+from ...models.base import Model, SumModel
 
 __all__ = ["PHYSICAL_RANGES", "non_physical", "non_physical_ranges", "physical_range",
            "report_lines"]
@@ -60,7 +60,7 @@ def non_physical_ranges(model: Model, bounds: Mapping[str, tuple[float, float]]
 
 
 def non_physical(channel: Any) -> dict[str, list[float]]:
-    """:func:`non_physical_ranges` of a :class:`~roughbrdf.fitting.result.ChannelFit` (its
+    """:func:`non_physical_ranges` of a :class:`~roughbrdf.fitting.results.result.ChannelFit` (its
     fitted model and search bounds): the ``non_physical_range`` entry of ``fit.json``."""
     return non_physical_ranges(channel.model, channel.bounds)
 

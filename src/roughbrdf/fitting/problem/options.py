@@ -2,14 +2,15 @@
 
 :func:`roughbrdf.fit` takes them as keywords (``rb.fit(model, meas, loss="log")``: the
 keywords build a :class:`FitOptions`) or typed (``rb.fit(model, meas, options=opts)``);
-:func:`~roughbrdf.fitting.compare.compare`, :func:`~roughbrdf.fitting.auto.fit_auto`,
-:func:`~roughbrdf.fitting.polarimetric.fit_mueller`, :class:`~roughbrdf.fitting.plan.FitPlan`,
+:func:`~roughbrdf.fitting.choice.compare.compare`, :func:`~roughbrdf.fitting.choice.auto.fit_auto`,
+:func:`~roughbrdf.fitting.kinds.polarimetric.fit_mueller`,
+:class:`~roughbrdf.fitting.problem.plan.FitPlan`,
 :func:`roughbrdf.catalogue.fit_catalogue` and the command line pass one along. Every check that
 needs no measurement nor model runs when the options are made (an
 :class:`~roughbrdf.errors.ArgumentError` naming the option); those that need them (``fix`` and
 ``bounds`` against the model's parameters, ``weights`` against the samples, ``relative_to``
 against the data, ``channel`` against its labels) run in
-:meth:`FitPlan.of <roughbrdf.fitting.plan.FitPlan.of>`, before any fit.
+:meth:`FitPlan.of <roughbrdf.fitting.problem.plan.FitPlan.of>`, before any fit.
 
 Examples
 --------
@@ -31,12 +32,12 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from ..errors import ArgumentError
-from ..instrument import Aperture
-from ..models.kcorr import parse_wavelength
-from ..quantity import LOSSES, Loss
+from ...errors import ArgumentError
+from ...instrument import Aperture
+from ...models.kcorr import parse_wavelength
+from ...quantity import LOSSES, Loss
 from .data import check_fit_domain, check_sample_options
-from .search import SearchOptions
+from .search_options import SearchOptions
 
 __all__ = ["AUTO_LOSS", "FitOptions", "MODEL_LOSSES", "check_loss", "check_polarimetric_weight",
            "check_scale", "default_loss"]
@@ -98,7 +99,7 @@ class FitOptions:
     loss : {"auto", "robust", "relative", "log", "absolute"}
         Residual: ``robust`` (soft-L1 of ``ln x - ln f``, scale 0.1), ``(x - f)/f`` (TR75
         Eq. 34, the papers' loss), ``ln x - ln f`` or ``x - f``
-        (:class:`roughbrdf.quantity.Loss`, :mod:`~roughbrdf.fitting.objective`). ``auto``
+        (:class:`roughbrdf.quantity.Loss`, :mod:`~roughbrdf.fitting.problem.objective`). ``auto``
         (default): the loss measured best for the model (:func:`default_loss`: ``robust``;
         ``relative`` for TR75, TS67, microfacet and sums with them; ``docs/fitting.md``,
         "Choosing the loss"); ``fit.json`` records the loss used.
@@ -169,14 +170,15 @@ class FitOptions:
         linear ramp to 0 beyond ``theta_r = 75`` deg): left out (counted in ``excluded``) or
         fitted too.
     joint : bool
-        Fit all channels at once (:mod:`~roughbrdf.fitting.joint`): the ``shared`` parameters
+        Fit all channels at once (:mod:`~roughbrdf.fitting.kinds.joint`): the ``shared`` parameters
         take one value for every channel, the others one per channel. Exactly ``starts``
         local fits in all (not per channel).
     shared : iterable of str, optional
         With ``joint=True``: the free parameters common to all channels. Default: every free
         parameter that is not a reflectance (roughness, index, lobe scales).
     polarimetric_weight : float, optional
-        Mueller data only (``measurement.mueller`` set, :mod:`~roughbrdf.fitting.polarimetric`):
+        Mueller data only (``measurement.mueller`` set,
+        :mod:`~roughbrdf.fitting.kinds.polarimetric`):
         the weight of the absolute residuals of the normalized elements ``m_ij/m00`` against
         the ``loss`` residuals of ``m00`` (default 1).
     progress : bool or None
@@ -274,7 +276,7 @@ class FitOptions:
         return dataclasses.replace(self, **changes)
 
     def search(self) -> SearchOptions:
-        """The search settings (:class:`~roughbrdf.fitting.search.SearchOptions`)."""
+        """The search settings (:class:`~roughbrdf.fitting.solvers.search.SearchOptions`)."""
         return SearchOptions(self.starts, self.screen, self.subsample, self.polish,
                              self.max_nfev, self.seed)
 

@@ -219,7 +219,10 @@ def search(full: Objective, explore: Objective, starts: list[np.ndarray],
         return SearchOutcome(first[1], first[2], tried, 0)
     # an end and its mirror (two lobes that traded places) are one end: compared, and
     # polished, in one form (ObjectiveSpec.canonical)
-    ends = [(c, full.spec.canonical(x), r) for c, x, r in ends]
+    # (a joint fit's layout has no such symmetry: its ends as they are)
+    canonical = getattr(full.spec, "canonical", None)
+    if canonical is not None:
+        ends = [(c, canonical(x), r) for c, x, r in ends]
     order = sorted(range(len(ends)), key=lambda i: ends[i][0])
     keep = _distinct([ends[i][1] for i in order], options.polish, hi - lo)
     # polished in the order of their starts, so that first_best's choice follows the starts

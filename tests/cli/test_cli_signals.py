@@ -45,7 +45,7 @@ _AT = textwrap.dedent("""
             os.kill(os.getpid(), sig)
 
     if where == "search":  # inside the fit: the first local fit of the search
-        from roughbrdf.fitting import search
+        from roughbrdf.fitting.solvers import search
         original = search.local_fit
 
         def local_fit(*args, **kwargs):

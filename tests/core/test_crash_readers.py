@@ -136,7 +136,7 @@ def _cli(args: list[str], folder: Path) -> tuple[int, tuple[str, str] | None]:
 
 
 def _read_plot(folder: Path, scratch: Path) -> Any:
-    from roughbrdf.fitting import result
+    from roughbrdf.fitting.results import result
 
     seen: list[dict[str, Any]] = []
     real = result.read_fit_json

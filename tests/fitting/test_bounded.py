@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import roughbrdf as rb
-from roughbrdf.fitting import search
+from roughbrdf.fitting.solvers import search
 from roughbrdf.fitting.solvers.bounded import LAMBDA_MAX, BoundedResult, bounded_lm, bounded_step
 
 

@@ -39,10 +39,11 @@ browser:
 # the suite (tests/), every docstring example in src/ and the README's examples (pyproject.toml),
 # in TEST_JOBS processes (pytest-xdist; one per core by default, TEST_JOBS=0 for one process:
 # the order of a plain run, e.g. to debug); --dist loadfile keeps a test file's tests (and its
-# module fixtures: the fits it shares) in one process
+# module fixtures: the fits it shares) in one process; the 15 slowest tests are listed (the
+# suite keeps within 15 minutes on a 2-core CI machine)
 TEST_JOBS ?= auto
 test: $(STAMP) browser
-	$(PY) -m pytest -q -p no:cacheprovider -n $(TEST_JOBS) --dist loadfile
+	$(PY) -m pytest -q -p no:cacheprovider -n $(TEST_JOBS) --dist loadfile --durations=15
 
 # The tests whose outcome could hang on the kernels' rounding (every fit of the shared paints and
 # the solvers), run again with the kernels compiled for an AVX2 processor without AVX-512 and

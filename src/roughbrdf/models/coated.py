@@ -279,6 +279,22 @@ def _smooth_packed(lobes: tuple[tuple[float, float], ...], n: float, distributio
     return (0.0, 0.0, *_smooth_factors(list(lobes), n, distribution, shadowing))
 
 
+def smooth_interface_factors(lobes: tuple[tuple[float, float], ...], n: float,
+                             distribution: str, shadowing: str) -> tuple[float, ...]:
+    """The smooth interface's factor ``s(mu) = min(1, (1 - E(mu))/(1 - R(mu)))`` at
+    :data:`~roughbrdf.diffuse.TABLE_NODES` for lobes ``((weight, alpha), ...)`` (cached): what
+    the coated model packs, shared with the layered models that sit under the same coat
+    (:mod:`roughbrdf.models.coated_conductor`).
+
+    Examples
+    --------
+    >>> s = smooth_interface_factors(((1.0, 0.005),), 1.5, "trowbridge-reitz", "smith-separable")
+    >>> len(s), round(float(s[-1]), 3)    # a nearly smooth lobe reflects R(0): the factor is 1
+    (64, 1.0)
+    """
+    return _smooth_packed(lobes, n, distribution, shadowing)[2:]
+
+
 @register
 class Coated(Model):
     """Coated material: rough dielectric interface (one or more lobes) over a diffuse substrate.

@@ -11,6 +11,7 @@ Harvey–Shack) and :mod:`.kcorr` (K-correlation / Rayleigh–Rice); ``docs/stra
 
 from .base import MODELS, Model, PreparedGeometry, SumModel, register
 from .coated import Coated
+from .coated_conductor import CoatedConductor
 from .factory import (
     as_model,
     available,
@@ -48,6 +49,7 @@ __all__ = [
     "spec_text",
     "ABg",
     "Coated",
+    "CoatedConductor",
     "HarveyShack",
     "KCorrelation",
     "Lambertian",

@@ -45,6 +45,8 @@ def _model(name):
 REFLECTANCES = {"lambertian": {"rho"}, "trowbridge-reitz-1975": {"rho_L"},
                 "torrance-sparrow-1967": {"rho_d"}, "renhorn-boreman-2008": {"bulk", "retro"},
                 "microfacet": set(), "coated": {"rho"}, "oren-nayar": {"rho"},
+                # metallic paint: none by default (its pigment d, rho come with diffuse=True)
+                "coated-conductor": set(),
                 # the stray-light models: a scale A or b0 (sr^-1), no reflectance
                 "abg": set(), "harvey-shack": set(), "k-correlation": set()}
 

@@ -207,6 +207,7 @@ def test_tr75_on_the_shared_paints_keeps_albedo_below_1(paints):
 @pytest.mark.parametrize(("spec", "expected"), [
     ("coated", True), ("coated(lobes=3, diffuse=oren-nayar)", True),
     ("coated(weights=free)", False), ("lambertian", True), ("tr75", False),
+    ("coated-conductor", True), ("metallic(diffuse=true)", True),
     ("microfacet", False), ("rb08", False)])
 def test_conserves_energy_says_what_the_construction_guarantees(spec, expected):
     # True only where docs/models.md §10.4 proves it (coated: tests/models/test_coated_energy.py's

@@ -184,6 +184,12 @@ def test_invalid_inputs_raise_naming_them():
                       ("n", math.nan)):
         with pytest.raises(ValueError, match=repr(name)):
             m.with_params(**{name: bad})
+    pigment = m.with_params(diffuse=True)
+    for name in ("d", "rho"):  # reflectance-like: [0, 1], as in every model
+        assert next(p for p in pigment.parameters if p.name == name).kind == "reflectance"
+        for bad in (1.0 + 1e-12, -1e-12, math.nan):
+            with pytest.raises(ValueError, match=repr(name)):
+                pigment.with_params(**{name: bad})
     with pytest.raises(ValueError, match="diffuse"):
         rb.model("metallic", diffuse="maybe")
     with pytest.raises(ValueError, match="distribution"):

@@ -59,7 +59,7 @@ from ..fresnel import diffuse_reflectance, fresnel_polarized_xy, fresnel_sp
 from ..geometry import half_vector, tr75_eta_xy
 from ..mueller import facet_mueller
 from .base import Model, PreparedGeometry, register
-from .parameters import Parameter, nonnegative, positive, reflectance
+from .parameters import Parameter, nonnegative, option_flag, positive, reflectance
 
 #: ``diffuse`` option -> code in the packed parameters
 DIFFUSE = {"lambertian": 0, "oren-nayar": 1}
@@ -78,7 +78,7 @@ _TABLE0 = 19
 
 
 @jit(inline=True)
-def _lobe(dcode, scode, a, ks, norm, hz, ci, cr):
+def lobe(dcode, scode, a, ks, norm, hz, ci, cr):
     """``ks D G/(cos theta_i cos theta_r)`` of one lobe (0 where ks = 0: the lobe is off)."""
     d = dist.evaluate_d(dcode, hz, a, norm)
     t = ks * d * shd.smith_g_over_cos_cos(scode, dcode, a, ci, cr)
@@ -110,9 +110,9 @@ def _coated_terms(ti, tr, phi, gamma, p, tab, dcode, rough):
     hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
     ex, ey = tr75_eta_xy(si, ci, hx, hy, hz)
     f = fresnel_polarized_xy(cd, n, 0.0, gamma, ex, ey)
-    spec = _lobe(dcode, scode, p[7], p[8], p[9], hz, ci, cr)
-    spec += _lobe(dcode, scode, p[10], p[11], p[12], hz, ci, cr)
-    spec += _lobe(dcode, scode, p[13], p[14], p[15], hz, ci, cr)
+    spec = lobe(dcode, scode, p[7], p[8], p[9], hz, ci, cr)
+    spec += lobe(dcode, scode, p[10], p[11], p[12], hz, ci, cr)
+    spec += lobe(dcode, scode, p[13], p[14], p[15], hz, ci, cr)
     if rough:  # a literal in each driver loop: the other interface's code compiles away
         diff = coated_diffuse_rough(ci, cr, n, rho, p[18], tab, 0)
     else:
@@ -371,11 +371,7 @@ class Coated(Model):
         if diffuse not in DIFFUSE:
             raise ValueError(f"diffuse must be 'lambertian' or 'oren-nayar', "
                              f"got {options['diffuse']!r}")
-        sd = options["shadow_diffuse"]
-        if isinstance(sd, str) and sd.strip().lower() in ("true", "false", "1", "0"):
-            sd = sd.strip().lower() in ("true", "1")
-        if not isinstance(sd, bool):
-            raise ValueError(f"shadow_diffuse must be true or false, got {sd!r}")
+        sd = option_flag(options["shadow_diffuse"], "shadow_diffuse")
         interface = str(options["interface"]).strip().lower()
         if interface not in INTERFACE:
             raise ValueError(f"interface must be 'smooth' or 'rough', "

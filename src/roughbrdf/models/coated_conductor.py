@@ -34,7 +34,6 @@ energy against a white furnace (measured in ``docs/models.md`` §10.5) and never
 from __future__ import annotations
 
 import math
-from typing import Any
 
 from numba import prange
 
@@ -45,18 +44,11 @@ from ..diffuse import table_lerp
 from ..fresnel import check_index, fresnel_polarized_cs, fresnel_polarized_xy, fresnel_sp
 from ..geometry import half_vector, tr75_eta_xy
 from .base import Model, register
-from .coated import smooth_interface_factors
-from .parameters import Parameter, nonnegative, positive, reflectance
+from .coated import lobe, smooth_interface_factors
+from .parameters import Parameter, nonnegative, option_flag, positive, reflectance
 
 #: index of the smooth interface's factor table s(mu) in the packed parameters
 _TABLE0 = 12
-
-
-@jit(inline=True)
-def _facets(dcode, scode, a, norm, hz, ci, cr):
-    """``D G/(cos theta_i cos theta_r)`` of one Smith microfacet lobe."""
-    return dist.evaluate_d(dcode, hz, a, norm) * shd.smith_g_over_cos_cos(scode, dcode, a, ci,
-                                                                          cr)
 
 
 @jit(inline=True)
@@ -70,7 +62,7 @@ def _flakes(ti, tr, phi, n, nm, km, am, norm, dcode, scode):
     si, sr = sincos(ti)[0], sincos(tr)[0]
     hx, hy, hz, cd, ci, cr, _ = half_vector(math.asin(si / n), math.asin(sr / n), phi)
     rs, rp = fresnel_sp(cd, nm, km)
-    t = 0.5 * (rs + rp) * _facets(dcode, scode, am, norm, hz, ci, cr)
+    t = 0.5 * (rs + rp) * lobe(dcode, scode, am, 1.0, norm, hz, ci, cr)
     # t = 0 (F = 0 at an index-matched base, or D underflowed): 0, never 0 * inf
     return 0.25 * t if t > 0.0 else 0.0
 
@@ -84,7 +76,7 @@ def _metallic_eval(ti, tr, phi, gamma, p, tab, flag, dcode):
     hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
     ex, ey = tr75_eta_xy(si, ci, hx, hy, hz)
     f = fresnel_polarized_xy(cd, n, 0.0, gamma, ex, ey)
-    coat = 0.25 * f * _facets(dcode, scode, a, norm, hz, ci, cr)
+    coat = 0.25 * f * lobe(dcode, scode, a, 1.0, norm, hz, ci, cr)
     # the coat's lobe is 0 where its facets are (0 * inf is excluded by Smith G -> 0 at
     # grazing, as in the coated model)
     t_in = 1.0 - fresnel_polarized_cs(ci, n, 0.0, gamma, 1.0, 0.0)
@@ -110,15 +102,6 @@ def _metallic_drive(a, b, c, g, p, flag, out):  # pragma: no cover - compiled
         for i in prange(out.size):
             out[i] = _metallic_eval(at(a, i), at(b, i), at(c, i), at(g, i), p, tab, flag,
                                     dist.BECKMANN)
-
-
-def _flag(value: Any, name: str) -> bool:
-    """A boolean option given as a bool or as ``"true"``/``"false"``/``"1"``/``"0"``."""
-    if isinstance(value, str) and value.strip().lower() in ("true", "false", "1", "0"):
-        value = value.strip().lower() in ("true", "1")
-    if not isinstance(value, bool):
-        raise ValueError(f"{name} must be true or false, got {value!r}")
-    return value
 
 
 @register
@@ -169,7 +152,7 @@ class CoatedConductor(Model):
             raise ValueError(f"the coated-conductor model's shadowing must be smith-separable "
                              f"or smith-height-correlated, got {options['shadowing']!r}")
         return {"distribution": d.name, "shadowing": shd.canonical(s),
-                "diffuse": _flag(options["diffuse"], "diffuse")}
+                "diffuse": option_flag(options["diffuse"], "diffuse")}
 
     def _parameter_specs(self) -> tuple[Parameter, ...]:
         specs = [

@@ -29,8 +29,8 @@ from typing import Any, NoReturn
 
 from ..errors import ArgumentError
 
-__all__ = ["Parameter", "REFLECTANCE_DOMAIN", "ReadOnlyDict", "nonnegative", "positive",
-           "reflectance"]
+__all__ = ["Parameter", "option_flag", "REFLECTANCE_DOMAIN", "ReadOnlyDict", "nonnegative",
+           "positive", "reflectance"]
 
 #: the one physical domain of every reflectance-like parameter, ``[0, 1]``
 #: (``(low, low_inclusive, high, high_inclusive)``)
@@ -197,3 +197,23 @@ class ReadOnlyDict(dict):
         import copy
 
         return type(self)(copy.deepcopy(dict(self), memo), self._owner)
+
+
+def option_flag(value: Any, name: str) -> bool:
+    """A model's boolean option given as a bool or as ``"true"``/``"false"``/``"1"``/``"0"``
+    (a spec or the command line gives text); a ValueError naming the option otherwise.
+
+    Examples
+    --------
+    >>> option_flag("True", "diffuse"), option_flag(False, "diffuse")
+    (True, False)
+    >>> option_flag("yes", "diffuse")
+    Traceback (most recent call last):
+    ...
+    ValueError: diffuse must be true or false, got 'yes'
+    """
+    if isinstance(value, str) and value.strip().lower() in ("true", "false", "1", "0"):
+        value = value.strip().lower() in ("true", "1")
+    if not isinstance(value, bool):
+        raise ValueError(f"{name} must be true or false, got {value!r}")
+    return value

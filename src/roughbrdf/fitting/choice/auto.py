@@ -38,7 +38,7 @@ from ...models import Model, spec_text
 from ..kinds.channels import fit_model, is_mueller
 from ..problem.options import FitOptions
 from ..problem.plan import channel_indices
-from ..results.plausibility import ENERGY_TOLERANCE, EnergyWarning, warn_energy
+from ..results.plausibility import EnergyWarning, warn_energy
 from .compare import (
     Candidate,
     as_candidates,
@@ -82,10 +82,11 @@ def fit_auto(measurement: Measurement, candidates: Sequence[Model | str] | str |
                                 "compare candidates (rb.compare)", value=value)
     with warnings.catch_warnings():  # the candidates not chosen do not matter: the best's below
         warnings.simplefilter("ignore", EnergyWarning)
-        if _staged(measurement, given, cv, candidates):
-            choice = _in_two_stages(measurement, as_candidates(candidates), given)
+        models = as_candidates(candidates)
+        if _staged(measurement, given, cv, len(models)):
+            choice = _in_two_stages(measurement, models, given)
         else:
-            choice = compare(measurement, candidates, cv=cv, options=given)
+            choice = compare(measurement, models, cv=cv, options=given)
     best = choice.best.result
     warn_energy(best, stacklevel=3)
     best.model_choice = choice
@@ -94,38 +95,37 @@ def fit_auto(measurement: Measurement, candidates: Sequence[Model | str] | str |
     return best
 
 
-def _staged(measurement: Measurement, options: FitOptions, cv: bool,
-            candidates: Sequence[Model | str] | str | None) -> bool:
+def _staged(measurement: Measurement, options: FitOptions, cv: bool, n_models: int) -> bool:
     """Whether the two stages apply: a score, channels fitted one by one, several of them,
     several incidences and candidates."""
     if not cv or options.joint or is_mueller(measurement):
         return False
     if measurement.incidences().size < 2:
         return False
-    n = 4 if candidates is None else len(as_candidates(candidates))
-    return n >= 2 and len(channel_indices(measurement, options.channel)) >= 2
+    return n_models >= 2 and len(channel_indices(measurement, options.channel)) >= 2
 
 
 def _in_two_stages(measurement: Measurement, models: list[Model], options: FitOptions) -> Any:
     """The :class:`~roughbrdf.fitting.choice.compare.ModelComparison` of the two stages (module
     notes)."""
     metric, losses = score_metric(models, options)
-    first, *rest = channel_indices(measurement, options.channel)
+    first = channel_indices(measurement, options.channel)[0]
     opt1 = options.replace(channel=[first])
-    stage1 = []
+    first_rows, helds = [], []
     for m in models:
         label = spec_text(m)
         res = fit_model(m, measurement, opt1, check_energy=False)
-        held = held_out_residuals(res, opt1, label=label, metric=metric)
-        stage1.append((label, res, held))
-    scores = [rms(h) for _, _, h in stage1]
-    sound = [s for s, (_, r, _) in zip(scores, stage1, strict=True) if not _gains_energy(r)]
+        helds.append(held_out_residuals(res, opt1, label=label, metric=metric))
+        first_rows.append(candidate(label, res, rms(helds[-1])))
+    scores = [rms(h) for h in helds]
+    sound = [s for s, r in zip(scores, first_rows, strict=True) if not r.gains_energy]
     best = min(sound or scores)
     rows: list[Candidate] = []
-    for m, score, (label, res, held) in zip(models, scores, stage1, strict=True):
+    for m, first_row, held, score in zip(models, first_rows, helds, scores, strict=True):
+        label, res = first_row.label, first_row.result
         if not score <= best * (1 + SKIP_MARGIN):  # NaN: skipped too
             channel = res.channels[0].channel
-            rows.append(candidate(label, res, score, partial=(
+            rows.append(dataclasses.replace(first_row, partial=(
                 f"fitted to channel {channel} only: its score there ({score:.4g}) is more "
                 f"than {SKIP_MARGIN:.0%} above the best's ({best:.4g})")))
             continue
@@ -138,9 +138,3 @@ def _in_two_stages(measurement: Measurement, models: list[Model], options: FitOp
                                                             metric=metric)])
         rows.append(candidate(label, whole, rms(held_all)))
     return comparison(rows, measurement, losses)
-
-
-def _gains_energy(res: FitResult) -> bool:
-    """Whether a fitted model of ``res`` reflects more than it receives."""
-    return any(res.plausibility(i).max_albedo > 1 + ENERGY_TOLERANCE
-               for i in range(len(res.channels)))

@@ -36,7 +36,7 @@ from ._kernels import TINY, as_float_array, jit, sincos, ufunc
 
 __all__ = ["fresnel_sp", "fresnel_amplitudes", "fresnel_polarized", "fresnel_polarized_cs",
            "fresnel_polarized_xy", "reflectance", "diffuse_reflectance",
-           "polarization_angle", "check_index"]
+           "polarization_angle", "check_index", "index_from_reflectance"]
 
 
 @jit(inline=True, contract=False)  # plain rounding: see roughbrdf._kernels.compile.jit
@@ -195,6 +195,43 @@ def check_index(n: float, k: float) -> None:
     if not (math.isfinite(k) and k >= 0):
         raise ValueError(
             f"extinction index k must be finite and >= 0 (n + ik, absorbing), got {k!r}")
+
+
+#: the largest normal reflectance :func:`index_from_reflectance` maps: ``r = 1`` (a perfect
+#: mirror) has an infinite index (g < 1) or n = 0 (g = 1); at ``1 - 1e-6`` the normal
+#: reflectance is within 1e-6 of 1 and the index stays finite and positive (n about 4e6 at
+#: g = 0, 5e-7 at g = 1)
+R_MAX = 1.0 - 1e-6
+
+
+def index_from_reflectance(r: float, g: float) -> tuple[float, float]:
+    """The complex index ``n + i k`` of a conductor of normal reflectance ``r`` and edge tint
+    ``g`` (Gulbrandsen 2014, "Artist Friendly Metallic Fresnel", JCGT 3(4), Eqs. 2-3).
+
+    ``n = g (1 - r)/(1 + r) + (1 - g)(1 + sqrt r)/(1 - sqrt r)`` and
+    ``k = sqrt((r (n + 1)^2 - (n - 1)^2)/(1 - r))``: every ``(r, g)`` in ``[0, 1]^2`` gives a
+    physical index (``n > 0``, ``k >= 0``) whose :func:`fresnel_sp` reflectance at normal
+    incidence is exactly ``r``; ``g`` sets how the reflectance rises toward grazing (``g = 1``:
+    the smallest ``n`` of that ``r``, ``g = 0``: the largest, ``k = 0``). The index is relative
+    to the medium the conductor is in. ``r`` above :data:`R_MAX` is taken as :data:`R_MAX`.
+
+    Examples
+    --------
+    >>> n, k = index_from_reflectance(0.95, 0.5)
+    >>> round(float(fresnel_sp(1.0, n, k)[0]), 12)        # the normal reflectance is r
+    0.95
+    >>> [round(v, 9) for v in index_from_reflectance(0.04, 0.0)]   # g = 0: glass, n = 1.5
+    [1.5, 0.0]
+    """
+    if not (0.0 <= r <= 1.0 and 0.0 <= g <= 1.0):
+        raise ValueError(f"normal reflectance r and edge tint g must be in [0, 1], got "
+                         f"r={r!r}, g={g!r}")
+    r = min(r, R_MAX)
+    sr = math.sqrt(r)
+    n = g * (1.0 - r) / (1.0 + r) + (1.0 - g) * (1.0 + sr) / (1.0 - sr)
+    # the radicand is >= 0 for n between the two bounds; rounding can make it -1e-16 at g = 0
+    k = math.sqrt(max(0.0, (r * (n + 1.0) ** 2 - (n - 1.0) ** 2) / (1.0 - r)))
+    return n, k
 
 
 def reflectance(

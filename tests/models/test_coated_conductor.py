@@ -8,9 +8,12 @@ Expected numbers and where they come from:
   ``rb.albedo`` and of the tabulated ``E``);
 * identities derived from the formula (§10.5): an index-matched, non-absorbing base
   (``n_m = n``, ``k_m = 0``) reflects nothing, leaving the coated model's lobe (``coated`` with
-  ``rho = 0``); an all-pigment base (``d = 1``) is the coated model's substrate without its
-  series of internal reflections, i.e. times ``1 - rho F_dr,int``; a coat of index ~1 is
-  invisible, leaving the flakes' ``microfacet`` lobe;
+  ``rho = 0``); an all-pigment base (``d = 1``) is the coated model's substrate (the same
+  formula, its series of internal reflections included); a coat of index ~1 is invisible,
+  leaving the flakes' ``microfacet`` lobe; no coat (``coat=False``) is the ``microfacet``
+  conductor lobe plus Lambertian pigment, ``(1 - d) f_microfacet + d rho/pi``;
+* ``flakes="reflectance"``: the index of :func:`roughbrdf.fresnel.index_from_reflectance`
+  (Gulbrandsen 2014, Eqs. 2-3), whose normal reflectance is ``r`` by construction;
 * a gold-like flake (``0.2 + 3.3i``, Johnson & Christy near 600 nm) under a smooth coat:
   ``0.04 + 0.96 * 0.91 * 0.96 ~ 0.84`` at normal incidence (coat ``R(0)``, ``T(0)``, the flakes'
   ``F(0)`` at the relative index ``(0.2 + 3.3i)/1.5``), so the albedo is > 0.5.
@@ -51,17 +54,25 @@ def _end_or(lo: float, hi: float):
 
 @st.composite
 def metallic_models(draw):
+    # every option, every parameter over its whole search box (the fits' domain)
     kw = {"distribution": draw(st.sampled_from(["trowbridge-reitz", "beckmann"])),
           "shadowing": draw(st.sampled_from(["smith-separable", "smith-height-correlated"])),
-          "n": draw(_end_or(1.3, 1.8)), "alpha": draw(_end_or(0.005, 1.5)),
-          "n_m": draw(_end_or(0.05, 3.0)), "k_m": draw(_end_or(0.0, 5.0)),
           "alpha_m": draw(_end_or(0.01, 1.5))}
+    if draw(st.booleans()):
+        kw.update(n=draw(_end_or(1.3, 1.8)), alpha=draw(_end_or(0.005, 1.5)))
+    else:
+        kw.update(coat=False)
+    if draw(st.booleans()):
+        kw.update(n_m=draw(_end_or(0.03, 4.0)), k_m=draw(_end_or(0.0, 8.0)))
+    else:
+        kw.update(flakes="reflectance", r_m=draw(_end_or(0.0, 1.0)),
+                  g_m=draw(_end_or(0.0, 1.0)))
     if draw(st.booleans()):
         kw.update(diffuse=True, d=draw(_end_or(0.0, 1.0)), rho=draw(_end_or(0.0, 1.0)))
     return rb.model("metallic", **kw)
 
 
-@settings(max_examples=25, deadline=None, derandomize=True,
+@settings(max_examples=40, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow])
 @given(metallic_models())
 def test_hypothesis_albedo_at_most_one(m):
@@ -103,20 +114,74 @@ def test_index_matched_base_leaves_the_coat_lobe():
                                            rtol=1e-12, atol=1e-300)
 
 
-def test_all_pigment_base_is_the_coated_substrate_single_scattered():
-    # d = 1: base = rho/pi; the coated substrate (same s, T, 1/n^2) has in addition the series
-    # of internal reflections 1/(1 - rho F_dr,int) (docs/models.md §10.3)
+def test_all_pigment_base_is_the_coated_substrate():
+    # d = 1: the pigment is the coated model's diffuse substrate, the same formula (same s,
+    # T, 1/n^2 and the series of internal reflections 1/(1 - rho F_dr,int), §10.3)
     ti, tr, ph = _geometries(3)
     kw = {"n": 1.5, "alpha": 0.15}
-    rho = 0.7
-    m = rb.model("metallic", diffuse=True, d=1.0, rho=rho, **kw)
-    c = rb.model("coated", rho=rho, shadow_diffuse=False, **kw)
-    c0 = c.with_params(rho=0.0)
-    f_int = rb.fresnel.diffuse_reflectance(1.5, internal=True)
+    m = rb.model("metallic", diffuse=True, d=1.0, rho=0.7, **kw)
+    c = rb.model("coated", rho=0.7, shadow_diffuse=False, **kw)
     for pol in (None, "s"):
-        base = m.brdf(ti, tr, ph, pol) - c0.brdf(ti, tr, ph, pol)
-        want = (c.brdf(ti, tr, ph, pol) - c0.brdf(ti, tr, ph, pol)) * (1.0 - rho * f_int)
-        np.testing.assert_allclose(base, want, rtol=1e-10, atol=1e-15)
+        np.testing.assert_allclose(m.brdf(ti, tr, ph, pol), c.brdf(ti, tr, ph, pol),
+                                   rtol=1e-10, atol=1e-15)
+
+
+def test_no_coat_is_a_rough_conductor_plus_pigment():
+    # coat=False: n = 1 (no Fresnel, no refraction, T = 1, s = 1): (1 - d) microfacet + d
+    # rho/pi, exactly, at every polarization (the flakes' F is unpolarized)
+    ti, tr, ph = _geometries(11)
+    for sh in ("smith-separable", "smith-height-correlated"):
+        m = rb.model("metallic", coat=False, n_m=0.5, k_m=2.0, alpha_m=0.25, shadowing=sh,
+                     diffuse=True, d=0.3, rho=0.8)
+        assert m.param_names == ["n_m", "k_m", "alpha_m", "d", "rho"]
+        flakes = rb.model("microfacet", n=0.5, k=2.0, alpha=0.25, ks=1.0, shadowing=sh)
+        want = 0.7 * flakes.brdf(ti, tr, ph) + 0.3 * 0.8 / math.pi
+        for pol in (None, "p"):
+            np.testing.assert_allclose(m.brdf(ti, tr, ph, pol), want, rtol=1e-12)
+
+
+def test_reflectance_form_is_the_index_form():
+    # flakes="reflectance": the flakes' index relative to the coat is index_from_reflectance
+    # (r_m, g_m); the same model as flakes="index" at n times that index (in air)
+    ti, tr, ph = _geometries(13)
+    for r, g in ((0.9, 0.3), (0.5, 1.0), (0.04, 0.0), (0.999, 0.7)):
+        m = rb.model("metallic", flakes="reflectance", r_m=r, g_m=g, n=1.6, alpha=0.1)
+        nm, km = rb.fresnel.index_from_reflectance(r, g)
+        assert m.flake_index() == (nm, km)
+        same = rb.model("metallic", n_m=1.6 * nm, k_m=1.6 * km, n=1.6, alpha=0.1)
+        np.testing.assert_allclose(m.brdf(ti, tr, ph), same.brdf(ti, tr, ph), rtol=1e-12)
+    assert rb.model("metallic", flakes="reflectance").param_names == \
+        ["n", "alpha", "r_m", "g_m", "alpha_m"]
+
+
+def test_unset_pigment_albedo_and_edge_tint_are_white_and_metal_like():
+    # rho = None: white pigment (1), not fitted; g_m = None: 1 (the smallest index of that
+    # reflectance); both the same model as the value given
+    ti, tr, ph = _geometries(17)
+    m = rb.model("metallic", flakes="reflectance", r_m=0.8, g_m=None, diffuse=True, d=0.3)
+    assert m.params["rho"] is None and m.params["g_m"] is None
+    same = m.with_params(rho=1.0, g_m=1.0)
+    np.testing.assert_allclose(m.brdf(ti, tr, ph), same.brdf(ti, tr, ph), rtol=1e-14)
+    assert rb.model("metallic", diffuse=True).params["rho"] is None  # the default
+
+
+def test_index_from_reflectance_is_gulbrandsens_map():
+    # Gulbrandsen 2014, Eqs. 2-3: normal reflectance r exactly (Fresnel at cos = 1, §1.4),
+    # n > 0, k >= 0; g = 0 the dielectric k = 0; g = 1 the smallest n, (1 - r)/(1 + r)
+    for r in (0.0, 0.04, 0.3, 0.7, 0.95, 0.999):
+        for g in (0.0, 0.25, 0.5, 1.0):
+            n, k = rb.fresnel.index_from_reflectance(r, g)
+            assert n > 0 and k >= 0
+            rs, rp = rb.fresnel.fresnel_sp(1.0, n, k)
+            assert rs == pytest.approx(r, abs=1e-12) and rp == pytest.approx(r, abs=1e-12)
+        assert rb.fresnel.index_from_reflectance(r, 1.0)[0] == pytest.approx((1 - r) / (1 + r))
+        assert rb.fresnel.index_from_reflectance(r, 0.0)[1] == pytest.approx(0.0, abs=1e-6)
+    n, k = rb.fresnel.index_from_reflectance(1.0, 0.5)  # r = 1: finite, reflectance ~1
+    assert math.isfinite(n) and math.isfinite(k)
+    assert rb.fresnel.fresnel_sp(1.0, n, k)[0] > 1 - 1e-5
+    for bad in ((1.2, 0.5), (0.5, -0.1), (math.nan, 0.5)):
+        with pytest.raises(ValueError, match="r and edge tint g"):
+            rb.fresnel.index_from_reflectance(*bad)
 
 
 def test_invisible_coat_leaves_the_flakes():
@@ -194,6 +259,14 @@ def test_invalid_inputs_raise_naming_them():
         rb.model("metallic", diffuse="maybe")
     with pytest.raises(ValueError, match="distribution"):
         rb.model("metallic", distribution="berry")
+    with pytest.raises(ValueError, match="flakes"):
+        rb.model("metallic", flakes="sparkly")
+    with pytest.raises(ValueError, match="coat"):
+        rb.model("metallic", coat="perhaps")
+    tinted = rb.model("metallic", flakes="reflectance")
+    for name, bad in (("r_m", 1.0 + 1e-9), ("g_m", -1e-9)):  # reflectance-like: [0, 1]
+        with pytest.raises(ValueError, match=repr(name)):
+            tinted.with_params(**{name: bad})
 
 
 def test_registration_parameters_and_options():
@@ -202,8 +275,10 @@ def test_registration_parameters_and_options():
     assert m.conserves_energy and m.reciprocal and not m.grazing_incidence
     assert m.param_names == ["n", "alpha", "n_m", "k_m", "alpha_m"]
     bounds = {p.name: p.bounds for p in m.parameters}
-    assert bounds["n"] == (1.3, 1.8) and bounds["n_m"] == (0.05, 3.0)
-    assert bounds["k_m"] == (0.0, 5.0)
+    # docs/fitting.md, "Bounds": clear coats 1.4-1.7; metals' n from silver's 0.03 to
+    # tungsten's ~4, k up to aluminium's ~8 in the visible
+    assert bounds["n"] == (1.3, 1.8) and bounds["n_m"] == (0.03, 4.0)
+    assert bounds["k_m"] == (0.0, 8.0)
     d = m.with_params(diffuse=True)
     assert d.param_names[-2:] == ["d", "rho"] and d.options["diffuse"] is True
     assert rb.model("metallic", diffuse="true").options["diffuse"] is True

@@ -33,6 +33,7 @@ energy against a white furnace (measured in ``docs/models.md`` §10.5) and never
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 from numba import prange
@@ -40,8 +41,15 @@ from numba import prange
 from .. import distributions as dist
 from .. import shadowing as shd
 from .._kernels import at, driver, jit, sincos, tuple_slice
-from ..diffuse import table_lerp
-from ..fresnel import check_index, fresnel_polarized_cs, fresnel_polarized_xy, fresnel_sp
+from ..diffuse import coated_diffuse, table_lerp
+from ..fresnel import (
+    check_index,
+    diffuse_reflectance,
+    fresnel_polarized_cs,
+    fresnel_polarized_xy,
+    fresnel_sp,
+    index_from_reflectance,
+)
 from ..geometry import half_vector, tr75_eta_xy
 from .base import Model, register
 from .coated import lobe, smooth_interface_factors
@@ -82,9 +90,12 @@ def _metallic_eval(ti, tr, phi, gamma, p, tab, flag, dcode):
     t_in = 1.0 - fresnel_polarized_cs(ci, n, 0.0, gamma, 1.0, 0.0)
     rs, rp = fresnel_sp(cr, n, 0.0)
     t_out = 1.0 - 0.5 * (rs + rp)
-    base = (1.0 - dd) * _flakes(ti, tr, phi, n, nm, km, am, norm_m, dcode, scode) \
-        + dd * rho / math.pi
-    layer = table_lerp(ci, tab, 0) * table_lerp(cr, tab, 0) * t_in * t_out * base / (n * n)
+    flakes = (1.0 - dd) * t_in * t_out / (n * n) * _flakes(ti, tr, phi, n, nm, km, am,
+                                                          norm_m, dcode, scode)
+    # the pigment: the coated model's diffuse substrate (its light trapped by the coat's
+    # internal reflection comes back out, 1/(1 - rho F_dr,int)); dd = 0 without diffuse=True
+    pigment = dd * coated_diffuse(ci, cr, n, gamma, rho, p[11]) if dd > 0.0 else 0.0
+    layer = table_lerp(ci, tab, 0) * table_lerp(cr, tab, 0) * (flakes + pigment)
     value = coat + layer
     return value * cr if flag else value
 
@@ -118,8 +129,13 @@ class CoatedConductor(Model):
 
     Options: ``distribution`` (``"trowbridge-reitz"``/GGX or ``"beckmann"``, for the coat and
     the flakes), ``shadowing`` (``"smith-separable"`` or ``"smith-height-correlated"``),
-    ``diffuse`` (``True``: a share ``d`` of pigment of albedo ``rho`` between the flakes,
-    ``base = (1 - d) f_flakes + d rho/pi``; default ``False``).
+    ``diffuse`` (``True``: a share ``d`` of pigment of albedo ``rho`` between the flakes, the
+    coated model's diffuse substrate; default ``False``), ``flakes`` (``"index"``: the flakes'
+    complex index ``n_m + i k_m`` in air, default; ``"reflectance"``: their normal reflectance
+    ``r_m`` inside the coat and edge tint ``g_m``, :func:`roughbrdf.fresnel.index_from_reflectance`
+    - the form a fit can determine: the data fix the flakes' reflectance, rarely ``n_m`` and
+    ``k_m`` apart), ``coat`` (``False``: no clear coat, ``n = 1``: a rough conductor, plus the
+    pigment, in air; default ``True``).
 
     Examples
     --------
@@ -138,7 +154,7 @@ class CoatedConductor(Model):
     short = "metal"
     reference = "Weidlich & Wilkie 2007; Walter et al. 2007; pbrt-v4 CoatedConductorBxDF"
     OPTIONS = {"distribution": "trowbridge-reitz", "shadowing": "smith-separable",
-               "diffuse": False}
+               "diffuse": False, "flakes": "index", "coat": True}
     _drive = _metallic_drive
 
     def _check_options(self, options):
@@ -151,33 +167,72 @@ class CoatedConductor(Model):
         if s not in (shd.SMITH_SEPARABLE, shd.SMITH_HEIGHT_CORRELATED):
             raise ValueError(f"the coated-conductor model's shadowing must be smith-separable "
                              f"or smith-height-correlated, got {options['shadowing']!r}")
+        flakes = str(options["flakes"]).strip().lower()
+        if flakes not in ("index", "reflectance"):
+            raise ValueError(f"flakes must be 'index' (n_m, k_m) or 'reflectance' (r_m, g_m), "
+                             f"got {options['flakes']!r}")
         return {"distribution": d.name, "shadowing": shd.canonical(s),
-                "diffuse": option_flag(options["diffuse"], "diffuse")}
+                "diffuse": option_flag(options["diffuse"], "diffuse"), "flakes": flakes,
+                "coat": option_flag(options["coat"], "coat")}
 
     def _parameter_specs(self) -> tuple[Parameter, ...]:
-        specs = [
-            Parameter("n", 1.5, (1.3, 1.8), "1", "refractive index of the clear coat",
-                      (1.0, False, math.inf, False)),
-            positive("alpha", 0.05, (0.005, 1.5), "1",
-                     "width of the coat's specular lobe (distribution parameter)"),
-            positive("n_m", 0.2, (0.05, 3.0), "1",
-                     "refractive index of the metal flakes (n_m + i k_m, in air)"),
-            nonnegative("k_m", 3.3, (0.0, 5.0), "1",
-                        "extinction index of the metal flakes (n_m + i k_m, in air)"),
-            positive("alpha_m", 0.2, (0.01, 1.5), "1",
-                     "width of the flakes' lobe (distribution parameter)"),
-        ]
-        if self._options["diffuse"]:
+        o = self._options
+        specs = []
+        if o["coat"]:
+            specs += [Parameter("n", 1.5, (1.3, 1.8), "1", "refractive index of the clear coat",
+                                (1.0, False, math.inf, False)),
+                      positive("alpha", 0.05, (0.005, 1.5), "1",
+                               "width of the coat's specular lobe (distribution parameter)")]
+        if o["flakes"] == "reflectance":
+            tint = reflectance("g_m", 0.5, "edge tint of the flakes (Gulbrandsen 2014: 0 the "
+                               "largest index of that r_m, 1 the smallest; None: 1, a metal's, "
+                               "not fitted)")
+            # search from 0.25: the metals of paints reflect 0.3-0.95 at normal incidence in
+            # a binder over the visible (docs/fitting.md, "Bounds"); below, the fit would be a
+            # dielectric's, which the coated model describes
+            specs += [reflectance("r_m", 0.9, "normal reflectance of the metal flakes (in the "
+                                  "coat)", bounds=(0.25, 1.0)),
+                      dataclasses.replace(tint, optional=True)]
+        else:
+            specs += [positive("n_m", 0.2, (0.03, 4.0), "1",
+                               "refractive index of the metal flakes (n_m + i k_m, in air)"),
+                      nonnegative("k_m", 3.3, (0.0, 8.0), "1",
+                                  "extinction index of the metal flakes (n_m + i k_m, in air)")]
+        specs.append(positive("alpha_m", 0.2, (0.01, 1.5), "1",
+                              "width of the flakes' lobe (distribution parameter)"))
+        if o["diffuse"]:
+            rho = reflectance("rho", 0.5, "albedo of the pigment (None: white, 1, not fitted: "
+                              "the data rarely tell it from the share d)")
             specs += [reflectance("d", 0.2, "share of pigment between the flakes"),
-                      reflectance("rho", 0.5, "albedo of the pigment")]
+                      dataclasses.replace(rho, value=None, optional=True)]
         return tuple(specs)
 
     def _validate(self) -> None:
         v = self._floats()
         code = dist.get(self._options["distribution"]).code
-        dist.check_param(code, v["alpha"], "alpha")
+        if self._options["coat"]:
+            dist.check_param(code, v["alpha"], "alpha")
         dist.check_param(code, v["alpha_m"], "alpha_m")
-        check_index(v["n_m"], v["k_m"])
+        if self._options["flakes"] == "index":
+            check_index(v["n_m"], v["k_m"])
+
+    def flake_index(self) -> tuple[float, float]:
+        """The flakes' complex index relative to the coat, ``(n_m + i k_m)/n`` (``flakes=
+        "index"``) or :func:`~roughbrdf.fresnel.index_from_reflectance` of ``r_m, g_m``.
+
+        Examples
+        --------
+        >>> import roughbrdf as rb
+        >>> m = rb.model("metallic", flakes="reflectance", r_m=0.04, g_m=0.0)
+        >>> [round(v, 6) for v in m.flake_index()]        # a dielectric of index 1.5 n
+        [1.5, 0.0]
+        """
+        v = self._floats()
+        if self._options["flakes"] == "reflectance":
+            # g_m = None: 1, the smallest index of that reflectance (metals: 0.97-1 by the map)
+            return index_from_reflectance(v["r_m"], v.get("g_m", 1.0))
+        n = v.get("n", 1.0)
+        return v["n_m"] / n, v["k_m"] / n
 
     @property
     def conserves_energy(self) -> bool:
@@ -188,9 +243,12 @@ class CoatedConductor(Model):
     def _pack(self) -> tuple:
         v, o = self._floats(), self._options
         d = dist.get(o["distribution"]).code
-        n = v["n"]
-        table = smooth_interface_factors(((1.0, v["alpha"]),), n, o["distribution"],
+        # no coat: n = 1, where the coat's Fresnel is 0 (its lobe vanishes), T = 1, s = 1
+        n, alpha = (v["n"], v["alpha"]) if o["coat"] else (1.0, v["alpha_m"])
+        table = smooth_interface_factors(((1.0, alpha),), n, o["distribution"],
                                          o["shadowing"])
-        return (n, v["alpha"], dist.normalization(d, v["alpha"]), v["n_m"] / n, v["k_m"] / n,
-                v["alpha_m"], dist.normalization(d, v["alpha_m"]), v.get("d", 0.0),
-                v.get("rho", 0.0), shd.get(o["shadowing"]).code, d, 0.0, *table)
+        nm, km = self.flake_index()
+        # no pigment: d = 0 (its term vanishes); rho = None: white pigment
+        return (n, alpha, dist.normalization(d, alpha), nm, km, v["alpha_m"],
+                dist.normalization(d, v["alpha_m"]), v.get("d", 0.0), v.get("rho", 1.0),
+                shd.get(o["shadowing"]).code, d, diffuse_reflectance(n, internal=True), *table)

@@ -25,14 +25,52 @@ from typing import Any
 
 from ...models.base import Model, SumModel
 
-__all__ = ["PHYSICAL_RANGES", "non_physical", "non_physical_ranges", "physical_range",
-           "report_lines"]
+__all__ = ["PHYSICAL_RANGES", "LIMIT_HINTS", "limit_hints", "non_physical",
+           "non_physical_ranges", "physical_range", "report_lines"]
 
 #: ``(model name, parameter) -> (low, high)``: the physical range of a free scale
 PHYSICAL_RANGES: dict[tuple[str, str], tuple[float, float]] = {
     ("microfacet", "ks"): (0.0, 1.0),
     ("coated", "ks"): (0.0, 1.0), ("coated", "ks2"): (0.0, 1.0), ("coated", "ks3"): (0.0, 1.0),
 }
+
+
+#: ``(model name, parameter, side) -> what it says about the model`` when a fit ends there on
+#: a search limit (``docs/fitting.md``, "Bounds"): clear coats and binders have n = 1.4-1.7; a
+#: coated fit that needs the coat's n at its upper limit asks for more reflection than a
+#: dielectric interface gives, the sign of metal flakes
+LIMIT_HINTS: dict[tuple[str, str, str], str] = {
+    ("coated", "n", "upper"): "a coat index this high is a sign of a wrong model (clear coats "
+    "have n = 1.4-1.7): metal flakes? try the metallic-paint model coated-conductor "
+    "(model auto compares it)",
+    ("coated-conductor", "n", "upper"): "a coat index this high (clear coats have n = "
+    "1.4-1.7) asks for more specular reflection than a coat gives: try "
+    "coated-conductor(coat=false), flakes without a clear coat",
+    ("trowbridge-reitz-1975", "n", "upper"): "an index this high is a sign of a wrong model for "
+    "a paint: try model auto (it compares the metallic-paint model)",
+}
+
+
+def limit_hints(channel: Any) -> list[str]:
+    """The report's hints for parameters that ended on a search limit (:data:`LIMIT_HINTS`).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> import roughbrdf as rb
+    >>> c = SimpleNamespace(model=rb.model("coated"), at_bound={"n": "upper"},
+    ...                     limits={"n": "search-upper"})
+    >>> limit_hints(c)[0].split(":")[0]
+    '    HINT (n at its upper search limit)'
+    """
+    lines = []
+    for name, side in getattr(channel, "at_bound", {}).items():
+        if not str(channel.limits.get(name, "search")).startswith("search"):
+            continue
+        hint = LIMIT_HINTS.get((channel.model.name, name.split("[")[0], side))
+        if hint:
+            lines.append(f"    HINT ({name} at its {side} search limit): {hint}")
+    return lines
 
 
 def physical_range(model: Model, name: str) -> tuple[float, float] | None:

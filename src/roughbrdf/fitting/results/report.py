@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING
 from ...errors import ArgumentError
 from ...quantity import Loss
 from ..problem.data import excluded_text
-from .physical import report_lines
+from .physical import limit_hints, report_lines
 
 if TYPE_CHECKING:
     from .result import ChannelFit, FitResult
@@ -244,6 +244,7 @@ def _variables(c: ChannelFit, angles: str = "rad") -> list[str]:
                       f"is no physical limit:",
                       "     the value is where the search stopped, not a result (widen the "
                       "bounds or change the model)"]
+            lines += limit_hints(c)  # what such a limit says about the model (physical.py)
     lines += report_lines(c)  # a search range beyond the physical one (fitting.results.physical)
     if c.free_scale:
         lines.append(f"    {'scale K':<{width}}: {fmt(c.scale, 7)} +/- "

@@ -155,13 +155,24 @@ class LightToolsFile:
         """Largest ``|integral - TIS|`` over channels and incidences (absolute)."""
         return float(max(np.max(np.abs(self.integral[c] - self.tis[c])) for c in self.tis))
 
+    @property
+    def relative_error(self) -> float:
+        """Largest ``|integral - TIS| / TIS`` over channels and incidences (a TIS of 0
+        compared absolutely: a table of nothing)."""
+        worst = 0.0
+        for c, t in self.tis.items():
+            t = np.asarray(t, dtype=float)
+            scale = np.where(np.abs(t) > 1e-12, np.abs(t), 1.0)  # no division by a zero TIS
+            worst = max(worst, float(np.max(np.abs(self.integral[c] - t) / scale)))
+        return worst
+
     def text(self) -> str:
         """Two lines: the file and grid, then TIS against the table's integral."""
         n_aoi, n_az, n_rad = self.grid.shape
         tis = {c: np.round(v, 4).tolist() for c, v in self.tis.items()}
         return (f"wrote {self.path}: {n_aoi}x{n_az}x{n_rad} (AOI x ScatterAzimuth x "
-                f"ScatterRadial, {self.grid.symmetry})\n  TIS {tis}; table integral within "
-                f"{self.integral_error:.2g} of it")
+                f"ScatterRadial, {self.grid.symmetry})\n  TIS {tis}; the table's own integral "
+                f"within {100 * self.relative_error:.2g} % of it at every AOI")
 
     def __str__(self) -> str:
         return self.text()

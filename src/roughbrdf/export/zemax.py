@@ -41,7 +41,6 @@ from typing import Any
 import numpy as np
 
 from ..errors import ArgumentError
-from ..geometry import specular_to_common
 from ..integrate import albedo
 from ..io.zemax import (
     HORIZON_EPS,
@@ -54,6 +53,14 @@ from ..io.zemax import (
 )
 from ..models.base import Model
 from ..output import OverwriteRefused
+from .grids import (
+    INTEGRAL_RTOL,
+    REFINE_TARGET,
+    Refined,
+    lobe_widths,
+    refine,
+    relative_errors,
+)
 
 __all__ = ["to_zemax", "default_grid", "model_table", "lobe_width", "ZemaxExport",
            "ZemaxFile", "DEFAULT_INCIDENCES_DEG"]
@@ -70,10 +77,10 @@ NODES_PER_HALF_WIDTH = 8
 
 def lobe_width(model: Model, aoi_deg: Any, *, polarization: Any = None) -> float | None:
     """Half width at half maximum (degrees) of the model's specular lobe: the narrowest, over
-    the incidences ``aoi_deg`` (degrees), of the radial angle out of the plane of incidence
-    (azimuth 90) at which the BRDF falls half way from its specular value to its lowest value
-    within 60 deg. None when no incidence shows a lobe (the specular value within 10 % of the
-    lowest: Lambertian-like).
+    the incidences ``aoi_deg`` (degrees), of
+    :func:`roughbrdf.export.grids.lobe_widths` (the radial angle out of the plane of
+    incidence at which the BRDF falls half way from its specular value to its lowest value
+    within 60 deg). None when no incidence shows a lobe (Lambertian-like).
 
     Examples
     --------
@@ -84,34 +91,20 @@ def lobe_width(model: Model, aoi_deg: Any, *, polarization: Any = None) -> float
     >>> 3.0 < w < 4.5
     True
     """
-    r = np.radians(np.geomspace(1e-3, 60.0, 400))
-    widths = []
-    for t in np.radians(np.atleast_1d(np.asarray(aoi_deg, dtype=float))):
-        if t > math.radians(89.0):  # out of the plane the lobe then lies on the horizon
-            continue
-        theta_r, phi, _ = specular_to_common(t, r, 0.5 * math.pi)
-        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            f = np.asarray(model.brdf(np.full(r.shape, t), theta_r, phi,
-                                      polarization=polarization), dtype=float)
-        if not np.isfinite(f).all():
-            continue
-        peak, low = f[0], f.min()
-        if peak - low <= 0.1 * abs(peak):  # no lobe worth resolving at this incidence
-            continue
-        below = np.flatnonzero(f < low + 0.5 * (peak - low))
-        widths.append(math.degrees(r[below[0]]))
+    widths = [w for w in lobe_widths(model.brdf, aoi_deg, polarization=polarization)
+              if w is not None]
     return min(widths) if widths else None
 
 
-def _graded_radial(width: float | None, rmax: float) -> np.ndarray:
+def _graded_radial(width: float | None, rmax: float, scale: float = 1.0) -> np.ndarray:
     """Radial angles (degrees) from 0 to ``rmax``: spacing ``width/8`` in the lobe, growing by
-    10 % a node, at most 2 deg."""
-    hmin = RADIAL_STEP_DEG if width is None else min(RADIAL_STEP_DEG,
-                                                     width / NODES_PER_HALF_WIDTH)
+    10 % a node, at most 2 deg (each times ``scale``, the refinement)."""
+    hmax = RADIAL_STEP_DEG * scale
+    hmin = hmax if width is None else min(hmax, scale * width / NODES_PER_HALF_WIDTH)
     nodes = [0.0]
     r = 0.0
     while r < rmax - 1e-9:
-        r = min(r + min(max(RADIAL_GROWTH * r, hmin), RADIAL_STEP_DEG), rmax)
+        r = min(r + min(max(RADIAL_GROWTH * scale * r, hmin), hmax), rmax)
         nodes.append(r)
     if len(nodes) > 2 and nodes[-1] - nodes[-2] < 0.25 * hmin:  # no sliver at the end
         nodes.pop(-2)
@@ -119,9 +112,11 @@ def _graded_radial(width: float | None, rmax: float) -> np.ndarray:
 
 
 def default_grid(model: Model, *, angles_of_incidence: Any = None,
-                 symmetry: str = "PlaneSymmetrical", polarization: Any = None) -> ZemaxGrid:
-    """The grid :func:`to_zemax` uses for ``model`` (module docstring); ``angles_of_incidence``
-    (radians) replaces the default incidences.
+                 symmetry: str = "PlaneSymmetrical", polarization: Any = None,
+                 level: int = 0) -> ZemaxGrid:
+    """The grid :func:`to_zemax` uses for ``model`` (module docstring) at refinement
+    ``level`` (each divides every spacing by sqrt 2); ``angles_of_incidence`` (radians)
+    replaces the default incidences.
 
     Examples
     --------
@@ -138,10 +133,11 @@ def default_grid(model: Model, *, angles_of_incidence: Any = None,
            else np.atleast_1d(np.asarray(angles_of_incidence, dtype=float)))
     checked = grid_from_radians(aoi, [0.0], [0.0], symmetry=sym)  # names a bad argument
     width = lobe_width(model, checked.aoi_deg, polarization=polarization)
-    radial = _graded_radial(width, 90.0 + max(checked.aoi_deg))
-    step = 5.0 if width is not None and width < 2.0 else 10.0
+    scale = 0.5 ** (0.5 * int(level))
+    radial = _graded_radial(width, 90.0 + max(checked.aoi_deg), scale)
+    step = scale * (5.0 if width is not None and width < 2.0 else 10.0)
     top = 180.0 if sym == "PlaneSymmetrical" else 360.0
-    azimuth = np.arange(0.0, top + 1e-9, step)
+    azimuth = np.round(np.linspace(0.0, top, math.ceil(top / step - 1e-9) + 1), 6)
     return ZemaxGrid(checked.aoi_deg, tuple(azimuth), tuple(radial), symmetry=sym)
 
 
@@ -210,14 +206,20 @@ class ZemaxFile:
         """Largest ``|integral - TIS|`` over the incidences (absolute)."""
         return float(np.max(np.abs(self.integral - self.tis)))
 
+    @property
+    def relative_error(self) -> float:
+        """Largest ``|integral - TIS| / TIS`` over the incidences
+        (:func:`roughbrdf.export.grids.relative_errors`)."""
+        return float(np.max(relative_errors(self.integral, self.tis)))
+
     def text(self) -> str:
         """Two lines: the file and grid, then TIS against the table's integral."""
         d = "x".join(map(str, self.grid.shape[1:]))
         ch = f" (channel {self.channel})" if self.channel is not None else ""
         return (f"wrote {self.path}{ch}: {d} (incidences x azimuths x radials, "
                 f"{self.grid.symmetry}), {self.n_below_horizon} nodes below the horizon "
-                f"(0)\n  TIS = rb.albedo {np.round(self.tis, 4).tolist()}; table integral "
-                f"within {self.integral_error:.2g} of it")
+                f"(0)\n  TIS = rb.albedo {np.round(self.tis, 4).tolist()}; the table's own "
+                f"integral within {100 * self.relative_error:.2g} % of it at every incidence")
 
 
 @dataclass(frozen=True)
@@ -361,16 +363,16 @@ def to_zemax(model_or_fit: Any, out: str | os.PathLike, *, angles_of_incidence: 
         isinstance(model_or_fit, Model) or channel is not None))
     _check_targets(targets, overwrite)
     notes = [refuse_energy_gain({label: mdl}, allow_energy_gain) for label, mdl in pairs]
-    grids = [_grid(mdl, angles_of_incidence, radial, azimuth, symmetry, polarization)
-             for _, mdl in pairs]
+    chosen = [_choose(mdl, angles_of_incidence, radial, azimuth, symmetry, polarization,
+                      str(path)) for (_, mdl), path in zip(pairs, targets, strict=True)]
     if len(targets) == 1:  # one file: written atomically on its own
-        return ZemaxExport([_write_one(pairs[0][1], pairs[0][0], grids[0], targets[0],
-                                       polarization, overwrite, notes[0])])
-    return ZemaxExport(_write_set(pairs, grids, targets, polarization, overwrite, notes))
+        return ZemaxExport([_write_one(pairs[0][1], pairs[0][0], chosen[0], targets[0],
+                                       overwrite, notes[0])])
+    return ZemaxExport(_write_set(pairs, chosen, targets, overwrite, notes))
 
 
-def _write_set(pairs: list[tuple[str | None, Model]], grids: list[ZemaxGrid],
-               targets: list[Path], polarization: Any, overwrite: bool,
+def _write_set(pairs: list[tuple[str | None, Model]],
+               chosen: list[tuple[Refined, np.ndarray]], targets: list[Path], overwrite: bool,
                notes: list[list[str]]) -> list[ZemaxFile]:
     """The channels' files as one set (:class:`roughbrdf.output.ResultFolder`, added to the
     folder's set): a kill or an error leaves all the old files or all the new ones.
@@ -388,41 +390,53 @@ def _write_set(pairs: list[tuple[str | None, Model]], grids: list[ZemaxGrid],
             ResultFolder(targets[0].parent, overwrite=overwrite, extend=True,
                          adopt=[p.name for p in targets]) as out:
         out.check([p.name for p in targets])  # before the (slow) tables
-        for (label, mdl), grid, path, note in zip(pairs, grids, targets, notes, strict=True):
+        for (label, mdl), table, path, note in zip(pairs, chosen, targets, notes, strict=True):
             tmp = Path(scratch) / path.name
-            done = _write_one(mdl, label, grid, tmp, polarization, True, note)
+            done = _write_one(mdl, label, table, tmp, True, note)
             out.add(path.name, tmp.read_bytes())
             tmp.unlink()
             files.append(replace(done, path=path))
     return files
 
 
-def _grid(model: Model, angles_of_incidence: Any, radial: Any, azimuth: Any, symmetry: str,
-          polarization: Any) -> ZemaxGrid:
-    """The grid for one model: the angles given, the defaults for the others."""
-    base = default_grid(model, angles_of_incidence=angles_of_incidence, symmetry=symmetry,
-                        polarization=polarization)
-    if radial is None and azimuth is None:
-        grid = base
-    else:
-        grid = grid_from_radians(np.radians(base.aoi_deg),
+def _choose(model: Model, angles_of_incidence: Any, radial: Any, azimuth: Any, symmetry: str,
+            polarization: Any, what: str) -> tuple[Refined, np.ndarray]:
+    """The table of one model and its TIS: on the default grid refined until its own integral
+    meets TIS (:func:`roughbrdf.export.grids.refine`), or on the angles given (``radial`` or
+    ``azimuth``: the grid as given, the other part the default's first level; a warning when
+    it misses). ``what`` names the file in a warning."""
+    def build(level: int) -> ZemaxGrid:
+        return default_grid(model, angles_of_incidence=angles_of_incidence, symmetry=symmetry,
+                            polarization=polarization, level=level)
+
+    base = build(0)
+    user = None
+    if radial is not None or azimuth is not None:
+        user = grid_from_radians(np.radians(base.aoi_deg),
                                  np.radians(base.azimuth_deg) if azimuth is None else azimuth,
                                  np.radians(base.radial_deg) if radial is None else radial,
                                  symmetry=base.symmetry)
-    if not model.grazing_incidence and max(grid.aoi_deg) >= 90.0:
+    if not model.grazing_incidence and max(base.aoi_deg) >= 90.0:
         raise ArgumentError("angles_of_incidence", f"{model.name} is not defined at grazing "
                             "incidence (theta_i = 90 deg); give angles below pi/2",
-                            value=math.radians(max(grid.aoi_deg)), unit="rad")
-    return grid
-
-
-def _write_one(model: Model, label: str | None, grid: ZemaxGrid, path: Path,
-               polarization: Any, overwrite: bool, notes: list[str]) -> ZemaxFile:
-    """Evaluate, integrate and write one file (``notes``: more header comments)."""
-    values, counts = model_table(model, grid, polarization=polarization)
-    tis = np.atleast_1d(np.asarray(albedo(model, np.radians(grid.aoi_deg),
+                            value=math.radians(max(base.aoi_deg)), unit="rad")
+    tis = np.atleast_1d(np.asarray(albedo(model, np.radians(base.aoi_deg),
                                           polarization=polarization), dtype=float))
-    integral = table_integral(values, grid)[0]
+
+    def evaluate(grid: ZemaxGrid) -> tuple[np.ndarray, np.ndarray, dict[str, int]]:
+        values, counts = model_table(model, grid, polarization=polarization)
+        return values, table_integral(values, grid)[0], counts
+
+    chosen = refine(lambda lv: base if lv == 0 else build(lv), evaluate, tis,
+                    size=lambda g: int(np.prod(g.shape)), user_grid=user, what=what)
+    return chosen, tis
+
+
+def _write_one(model: Model, label: str | None, chosen: tuple[Refined, np.ndarray],
+               path: Path, overwrite: bool, notes: list[str]) -> ZemaxFile:
+    """Write one file (``notes``: more header comments)."""
+    table, tis = chosen
+    grid, values, integral = table.grid, table.values, table.integral
     comments = [f"roughbrdf export of {model!r}"]
     if label is not None:
         comments.append(f"channel: {label}")
@@ -431,8 +445,20 @@ def _write_one(model: Model, label: str | None, grid: ZemaxGrid, path: Path,
         "specular direction, ScatterAzimuth = 0 toward the surface normal, counter-clockwise "
         "seen from above; AngleOfIncidence = theta_i = the specular angle",
         "TIS = the model's directional-hemispherical reflectance (roughbrdf.albedo); the "
-        f"table's own integral is within {float(np.max(np.abs(integral - tis))):.2g} of it",
-        "directions below the horizon hold 0", *notes]
+        "table's own integral (trapezoid rule on this file's nodes) is within "
+        f"{100 * float(np.max(table.errors)):.2g} % of it at every AngleOfIncidence",
+        _grid_note(table.level), "directions below the horizon hold 0", *notes]
+    if table.warning is not None:
+        comments.append("warning: " + table.warning)
     tis_all = np.broadcast_to(tis, grid.shape[:2])
     write_table(path, grid, values, tis_all, comments=comments, overwrite=overwrite)
-    return ZemaxFile(Path(path), label, repr(model), grid, tis, integral, **counts)
+    return ZemaxFile(Path(path), label, repr(model), grid, tis, integral, **table.extra)
+
+
+def _grid_note(level: int | None) -> str:
+    """The header comment saying how the grid was chosen."""
+    if level is None:
+        return "grid: as given"
+    return (f"grid: graded from the specular direction, refinement level {level}, chosen so "
+            f"that the table's own integral is within {100 * REFINE_TARGET:g} % of TIS "
+            f"(promised: {100 * INTEGRAL_RTOL:g} %)")

@@ -5,7 +5,8 @@ Targets: zemax, mitsuba, mitsuba-xml, lighttools, zemax-abg (:data:`roughbrdf.ex
 Writes a model, or the fitted models of a saved fit (``fit.json``), for another tool
 (:func:`roughbrdf.export.export`, ``docs/export.md``): a Zemax OpticStudio tabular BSDF
 (``.bsdf``; a fit gives ``<stem>_<channel>.bsdf`` per channel; grid options ``--incidences``,
-``--radial``, ``--azimuth`` in degrees, ``--symmetry``), a Mitsuba 3 scene-description dict as
+``--radial``, ``--azimuth`` in degrees, ``--symmetry``; LightTools takes the first three), a
+Mitsuba 3 scene-description dict as
 JSON, or a Mitsuba 3 XML ``<bsdf>``. What does not map onto Mitsuba is refused with the reason,
 or with ``--fit-closest`` exported as the closest Mitsuba model fitted to it, with the deviation
 printed. A model that reflects more than it receives (albedo above 1 + 1e-3 at an incidence of
@@ -89,9 +90,9 @@ def run_export(model: str | None, param: list[str] | None, fit_dir: str | None, 
         if target == "zemax-abg" and grid:
             raise ValueError("--incidences, --radial, --azimuth and --symmetry do not apply to "
                              "--to zemax-abg (its rows are the fit's incidences)")
-        if target == "lighttools" and set(grid) - {"angles_of_incidence"}:
-            raise ValueError("--radial, --azimuth and --symmetry are Zemax's grid (angles from "
-                             "the specular direction); --to lighttools takes --incidences")
+        if target == "lighttools" and "symmetry" in grid:
+            raise ValueError("--symmetry is Zemax's; --to lighttools writes the whole circle "
+                             "(Asymmetric) and takes --incidences, --radial, --azimuth")
         options = grid
     elif target == "zemax":
         if rgb is not None or fit_closest or theta_max is not None:
@@ -117,7 +118,9 @@ def run_export(model: str | None, param: list[str] | None, fit_dir: str | None, 
     res = export(source, Path(out), to=target, overwrite=force, channel=chan,
                  allow_energy_gain=allow_energy_gain, **options)
     typer.echo(res.report)
-    typer.echo("wrote " + ", ".join(str(p) for p in res.paths))
+    for path in res.paths:  # one "wrote" line per file: those the report has not given
+        if not any(line.startswith(f"wrote {path}") for line in res.report.splitlines()):
+            typer.echo(f"wrote {path}")
 
 
 def register(app: typer.Typer) -> None:
@@ -139,12 +142,16 @@ def register(app: typer.Typer) -> None:
         channel: str = typer.Option(None, "--channel", "-c",
                                     help="one channel of the fit (label or index)"),
         incidences: str = typer.Option(None, "--incidences", metavar="DEG|START:STOP:STEP",
-                                       help="Zemax: angles of incidence (default 0:80:10)"),
+                                       help="Zemax, LightTools: angles of incidence "
+                                            "(default 0:80:10)"),
         radial: str = typer.Option(None, "--radial", metavar="START:STOP:STEP",
-                                   help="Zemax: scatter angles from the specular direction "
-                                        "(default: graded, dense near specular)"),
+                                   help="Zemax: scatter angles from the specular direction; "
+                                        "LightTools: polar angles from the normal (default: "
+                                        "graded, dense near specular, refined until the "
+                                        "table integrates to TIS within 0.5 %)"),
         azimuth: str = typer.Option(None, "--azimuth", metavar="START:STOP:STEP",
-                                    help="Zemax: azimuths about the specular direction"),
+                                    help="Zemax: azimuths about the specular direction; "
+                                         "LightTools: about the normal, source at 90"),
         symmetry: str = typer.Option(None, "--symmetry",
                                      help="Zemax: PlaneSymmetrical (default) or Asymmetrical"),
         rgb: bool = typer.Option(None, "--rgb/--no-rgb",

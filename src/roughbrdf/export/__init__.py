@@ -101,8 +101,12 @@ def export(source: Any, out: str | os.PathLike, *, to: str, overwrite: bool = Fa
     channel : int or str, optional
         One channel of a fit.
     **options
-        The target's own: Zemax ``angles_of_incidence``, ``radial``, ``azimuth`` (radians),
-        ``symmetry``, ``polarization`` (:func:`~roughbrdf.export.zemax.to_zemax`); Mitsuba
+        The target's own: Zemax and LightTools ``angles_of_incidence``, ``radial``,
+        ``azimuth`` (radians), ``symmetry``, ``polarization``
+        (:func:`~roughbrdf.export.zemax.to_zemax`,
+        :func:`~roughbrdf.export.lighttools.to_lighttools`: a grid refined until each table's
+        own integral is within 0.5 % of its TIS, or the ``radial``/``azimuth`` given, with a
+        :class:`~roughbrdf.export.grids.TableAccuracyWarning` when they miss it); Mitsuba
         ``rgb``, ``fit``, ``theta_max`` (:func:`~roughbrdf.export.mitsuba.export_mitsuba`);
         both ``allow_energy_gain``: a model whose albedo exceeds ``1 + 1e-3`` at an incidence
         of 0, 5, ... 85, 89 deg is refused (an :class:`~roughbrdf.errors.ArgumentError`
@@ -130,8 +134,8 @@ def export(source: Any, out: str | os.PathLike, *, to: str, overwrite: bool = Fa
     """
     target = target_name(to)
     if target in ("lighttools", "zemax-abg"):
-        paths = _write_straylight(target, source, Path(out), channel, overwrite, options)
-        return ExportResult(target, paths, "wrote " + ", ".join(map(str, paths)))
+        paths, lines = _write_straylight(target, source, Path(out), channel, overwrite, options)
+        return ExportResult(target, paths, "\n".join(lines))
     if target == "zemax":
         from .zemax import to_zemax
 
@@ -178,10 +182,12 @@ def _channel_models(source: Any, channel: Any) -> list[tuple[str | None, Any, An
 
 
 def _write_straylight(target: str, source: Any, out: Path, channel: Any, overwrite: bool,
-                      options: dict[str, Any]) -> list[Path]:
+                      options: dict[str, Any]) -> tuple[list[Path], list[str]]:
     """The LightTools file(s) (:func:`~roughbrdf.export.lighttools.to_lighttools`) or the Zemax
     ABg table(s) (:func:`~roughbrdf.export.abg_catalog.write_abg_catalog`), one per channel
-    (``<stem>_<channel><suffix>``); every target checked before the first is written."""
+    (``<stem>_<channel><suffix>``); every target checked before the first is written. Returns
+    the paths and the report: one ``wrote`` line per file (a LightTools file's with its grid
+    and how close its integral is to TIS)."""
     from ..output import refuse_existing
 
     suffix = ".bsdf" if target == "lighttools" else ".txt"
@@ -191,13 +197,14 @@ def _write_straylight(target: str, source: Any, out: Path, channel: Any, overwri
              for lab, _, _ in items]
     for p in paths:
         refuse_existing(p, overwrite)
-    done = []
+    done, lines = [], []
     for (lab, obj, ch), path in zip(items, paths, strict=True):
         if target == "lighttools":
             from .lighttools import to_lighttools
 
-            done.append(to_lighttools(obj, path, channel=ch, overwrite=overwrite,
-                                      **options).path)
+            written = to_lighttools(obj, path, channel=ch, overwrite=overwrite, **options)
+            done.append(written.path)
+            lines.append(written.text())
         else:
             from .abg_catalog import write_abg_catalog
 
@@ -205,7 +212,8 @@ def _write_straylight(target: str, source: Any, out: Path, channel: Any, overwri
             if lab is not None and "name" not in opts:  # one catalog name per channel
                 opts["name"] = _safe(f"{base.stem}_{lab}")[:31]
             done.append(write_abg_catalog(obj, path, channel=ch, overwrite=overwrite, **opts))
-    return done
+            lines.append(f"wrote {done[-1]}")
+    return done, lines
 
 
 def _safe(label: str) -> str:

@@ -56,7 +56,14 @@ from ..io.lighttools_write import (
     write_measurement,
 )
 from ..output import atomic_write, refuse_existing
-from .grids import INTEGRAL_RTOL, REFINE_TARGET, graded_axis, lobe_widths, refine
+from .grids import (
+    INTEGRAL_RTOL,
+    REFINE_TARGET,
+    cell_rule,
+    graded_axis,
+    lobe_widths,
+    refine,
+)
 
 __all__ = ["to_lighttools", "write_measurement", "format_table", "model_table",
            "table_integral", "default_grid", "LightToolsFile", "DEFAULT_INCIDENCES_DEG",
@@ -308,9 +315,12 @@ def to_lighttools(model: Any, out: str | os.PathLike, *, angles_of_incidence: An
     else:
         tis_known, how = None, "the table's own cosine-weighted integral (trapezoid rule)"
 
-    def evaluate(grid: LightToolsGrid) -> tuple[np.ndarray, np.ndarray]:
+    def evaluate(grid: LightToolsGrid) -> tuple[np.ndarray, np.ndarray, np.ndarray, None]:
         values = model_table(model, grid, polarization=polarization)
-        return values, table_integral(grid, values)
+        t = np.radians(np.minimum(grid.radial_deg, 90.0))
+        cells = cell_rule(values, t, np.radians(grid.azimuth_deg), np.cos(t)[None, :],
+                          factor=2.0 if grid.symmetry == "PlaneSymmetrical" else 1.0)
+        return values, table_integral(grid, values), cells, None
 
     chosen = refine(lambda lv: first if lv == 0 else build(lv), evaluate, tis_known,
                     size=lambda g: int(np.prod(g.shape)), user_grid=first if given else None,

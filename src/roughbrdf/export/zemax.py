@@ -57,6 +57,7 @@ from .grids import (
     INTEGRAL_RTOL,
     REFINE_TARGET,
     Refined,
+    cell_rule,
     lobe_widths,
     refine,
     relative_errors,
@@ -423,9 +424,18 @@ def _choose(model: Model, angles_of_incidence: Any, radial: Any, azimuth: Any, s
     tis = np.atleast_1d(np.asarray(albedo(model, np.radians(base.aoi_deg),
                                           polarization=polarization), dtype=float))
 
-    def evaluate(grid: ZemaxGrid) -> tuple[np.ndarray, np.ndarray, dict[str, int]]:
+    def evaluate(grid: ZemaxGrid) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                          dict[str, int]]:
         values, counts = model_table(model, grid, polarization=polarization)
-        return values, table_integral(values, grid)[0], counts
+        a = np.radians(grid.azimuth_deg)
+        v, cz = values[0], grid.directions()[3]
+        if grid.symmetry != "PlaneSymmetrical" and a[-1] < a[0] + 2 * math.pi - 1e-9:
+            # the circle is closed by the first azimuth's column (as table_integral does)
+            a = np.append(a, a[0] + 2 * math.pi)
+            v, cz = (np.concatenate([x, x[:, :1]], axis=1) for x in (v, cz))
+        cells = cell_rule(v, np.radians(grid.radial_deg), a, cz,
+                          factor=2.0 if grid.symmetry == "PlaneSymmetrical" else 1.0)
+        return values, table_integral(values, grid)[0], cells, counts
 
     chosen = refine(lambda lv: base if lv == 0 else build(lv), evaluate, tis,
                     size=lambda g: int(np.prod(g.shape)), user_grid=user, what=what)

@@ -125,11 +125,16 @@ def default_grid(angles_of_incidence: Any = None, *, radial: Any = None, azimuth
         rad, az = _lobe_axes(model, aoi, symmetry, level, polarization)
         return LightToolsGrid(aoi, az if az_given is None else az_given,
                               rad if rad_given is None else rad_given, symmetry)
-    except ArgumentError as exc:  # name the Python argument, in radians
+    except ArgumentError as exc:  # name the Python argument; the angle in radians
         name = {"aoi_deg": "angles_of_incidence", "azimuth_deg": "azimuth",
                 "radial_deg": "radial"}.get(exc.argument, exc.argument)
-        raise ArgumentError(name, exc.message + " (given in radians here)",
-                            value=exc.value) from None
+        message = re.sub(r"\[(\S+), (\S+)\] deg", lambda m: f"{m[0]} ("
+                         f"{math.radians(float(m[1])):.4g} to {math.radians(float(m[2])):.4g} "
+                         "rad)", exc.message)
+        if isinstance(exc.value, float):  # one angle (degrees here): shown in each unit
+            raise ArgumentError(name, message, value=math.radians(exc.value),
+                                unit="rad") from None
+        raise ArgumentError(name, message + " (the file's degrees)", value=exc.value) from None
 
 
 def _lobe_axes(model: Any, aoi: tuple[float, ...], symmetry: str, level: int,

@@ -123,7 +123,8 @@ def format_table(grid: LightToolsGrid, tables: Mapping[str, np.ndarray],
             if spectral == "XYZ":
                 out.append(f"TristimulusValue Tris{ch}")
             out.append(f"TIS {VALUE_FORMAT % t[i]}")
-            out += [" ".join(VALUE_FORMAT % v for v in row) for row in vals[i]]
+            row_format = " ".join([VALUE_FORMAT] * grid.shape[2])  # one % per row: fast
+            out += [row_format % tuple(row) for row in vals[i].tolist()]
     out.append("DataEnd")
     return "\n".join(out) + "\n"
 

@@ -137,8 +137,10 @@ def default_grid(model: Model, *, angles_of_incidence: Any = None,
     scale = 0.5 ** (0.5 * int(level))
     radial = _graded_radial(width, 90.0 + max(checked.aoi_deg), scale)
     step = scale * (5.0 if width is not None and width < 2.0 else 10.0)
-    top = 180.0 if sym == "PlaneSymmetrical" else 360.0
-    azimuth = np.round(np.linspace(0.0, top, math.ceil(top / step - 1e-9) + 1), 6)
+    half = math.ceil(180.0 / step - 1e-9)  # steps over a half circle: the whole circle is
+    # its mirror image, so that both symmetries give the same table and integral
+    top, steps = (180.0, half) if sym == "PlaneSymmetrical" else (360.0, 2 * half)
+    azimuth = np.round(np.linspace(0.0, top, steps + 1), 6)
     return ZemaxGrid(checked.aoi_deg, tuple(azimuth), tuple(radial), symmetry=sym)
 
 

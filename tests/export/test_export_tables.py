@@ -113,7 +113,7 @@ def test_table_integral_within_half_a_percent_of_tis_at_every_incidence(files, f
 @pytest.mark.parametrize("fmt", ["lighttools", "zemax"])
 def test_libbsdf_agrees(files, fmt):
     """libbsdf's figures for the same files (above) within 0.5 % of TIS, and of the table's own
-    integral: measured 0.13 % at most on the nodes, 0.24 % with its 360 x 360 rule."""
+    integral: measured 0.13 % at most on the nodes, 0.31 % with its 360 x 360 rule."""
     name, done = files
     shape, tis, integral, _ = done[fmt]
     ref_shape, figures = LIBBSDF[(name, fmt)]

@@ -15,14 +15,18 @@ The default grid:
 * ``ScatterAzimuth`` every 10 deg (5 deg when the lobe is narrower than 2 deg) over 0-180
   (``PlaneSymmetrical``) or 0-360 (``Asymmetrical``).
 
-How good the table is, is measured by its own integral
-(:func:`roughbrdf.io.zemax.table_integral`) against TIS. With the default grid the difference
-stays below 1.3e-3 (absolute) at every incidence for the Lambertian, coated, microfacet GGX
-(alpha 0.05 and 0.3), Oren-Nayar, TS67 and TR75 models (``tests/export/test_export_zemax.py``). What
-limits it is the grid: a lobe narrower than the radial spacing (the radial angles are shared by
-all incidences, so the spacing follows the narrowest lobe), the horizon, which cuts the lobe
-between nodes at grazing incidence (the largest errors are at 80 deg), and the azimuth step
-near the horizon. Finer ``radial``/``azimuth`` reduce it at the cost of size.
+That grid is level 0: the table is refined (each level divides every spacing by sqrt 2)
+until its own integral (:func:`roughbrdf.io.zemax.table_integral`, the trapezoid rule on the
+file's nodes) and a second rule on the same nodes
+(:func:`roughbrdf.export.grids.cell_rule`) are within 0.25 % of TIS at every incidence, which
+keeps the promised 0.5 % (:data:`roughbrdf.export.grids.INTEGRAL_RTOL`) for other readers'
+rules too (:func:`roughbrdf.export.grids.refine`; at most 2e6 values, a warning beyond). What
+limits the accuracy is the grid: a lobe narrower than the radial spacing (the radial angles are
+shared by all incidences, so the spacing follows the narrowest lobe), the horizon, which cuts
+the lobe between nodes at grazing incidence (the largest errors are at 80 deg), and the
+azimuth step near the horizon. A ``radial`` or ``azimuth`` given is used as given, with one
+:class:`~roughbrdf.export.grids.TableAccuracyWarning` naming the shortfall when it misses
+0.5 %.
 
 Directions below the horizon (radial angles past it) hold 0; directions exactly at the horizon
 hold the model's value there (0 where the model has no finite value there, counted).

@@ -39,6 +39,7 @@ TARGETS = {
     "mitsuba-xml": "Mitsuba 3 XML <bsdf> element (a document mitsuba.load_string loads)",
     "lighttools": "LightTools BSDF (.bsdf), one file per channel",
     "zemax-abg": "Zemax OpticStudio ABg catalog values (.txt table to enter; ABg fits only)",
+    "rgl": "RGL measured-BSDF tensor file (.bsdf; Mitsuba 3 'measured', Dupuy & Jakob 2018)",
 }
 
 
@@ -91,11 +92,12 @@ def export(source: Any, out: str | os.PathLike, *, to: str, overwrite: bool = Fa
         The file (``.bsdf``, ``.json`` or ``.xml`` added without a suffix). A fit whose
         channels are not one BSDF gives one file per channel, ``<stem>_<channel><suffix>``
         beside it (Mitsuba: where the channels differ in more than colours).
-    to : {"zemax", "mitsuba", "mitsuba-xml", "lighttools", "zemax-abg"}
+    to : {"zemax", "mitsuba", "mitsuba-xml", "lighttools", "zemax-abg", "rgl"}
         The target (:data:`TARGETS`): also LightTools BSDF files
-        (:func:`~roughbrdf.export.lighttools.to_lighttools`) and the Zemax ABg catalog
+        (:func:`~roughbrdf.export.lighttools.to_lighttools`), the Zemax ABg catalog
         values of an ABg fit (:func:`~roughbrdf.export.abg_catalog.write_abg_catalog`; a
-        per-incidence fit writes its kept rows).
+        per-incidence fit writes its kept rows) and an RGL measured-BSDF file, all channels
+        in one (:func:`~roughbrdf.export.rgl.to_rgl`).
     overwrite : bool
         Replace existing files (default: refuse, before writing anything).
     channel : int or str, optional
@@ -108,6 +110,7 @@ def export(source: Any, out: str | os.PathLike, *, to: str, overwrite: bool = Fa
         own integral is within 0.5 % of its TIS, or the ``radial``/``azimuth`` given, with a
         :class:`~roughbrdf.export.grids.TableAccuracyWarning` when they miss it); Mitsuba
         ``rgb``, ``fit``, ``theta_max`` (:func:`~roughbrdf.export.mitsuba.export_mitsuba`);
+        RGL ``color``, ``resolution``, ``description`` (:func:`~roughbrdf.export.rgl.to_rgl`);
         both ``allow_energy_gain``: a model whose albedo exceeds ``1 + 1e-3`` at an incidence
         of 0, 5, ... 85, 89 deg is refused (an :class:`~roughbrdf.errors.ArgumentError`
         naming the albedo and the incidence) unless it is True, which the file records (a
@@ -133,6 +136,11 @@ def export(source: Any, out: str | os.PathLike, *, to: str, overwrite: bool = Fa
     roughbrdf.output.OverwriteRefused: ...paint.xml exists; not overwriting it (pass overwrite=True)
     """
     target = target_name(to)
+    if target == "rgl":
+        from .rgl import to_rgl
+
+        rgl = to_rgl(source, out, channel=channel, overwrite=overwrite, **options)
+        return ExportResult(target, [rgl.path], rgl.text(), rgl)
     if target in ("lighttools", "zemax-abg"):
         paths, lines = _write_straylight(target, source, Path(out), channel, overwrite, options)
         return ExportResult(target, paths, "\n".join(lines))

@@ -186,3 +186,35 @@ def test_refuses_to_overwrite_and_names_bad_arguments(tmp_path):
     with pytest.raises(ArgumentError, match="channel"):
         to_rgl(MODELS["abg"], tmp_path / "y.bsdf", channel=0)
     assert not (tmp_path / "y.bsdf").exists()
+
+
+def test_one_channel_of_a_fit_by_label_or_index(tmp_path):
+    fit = {"465nm": rb.model("coated", rho=0.2), "630nm": rb.model("coated", rho=0.7)}
+    small = {"theta_i": 3, "samples": 4, "vndf": 8, "ndf": 16}
+    by_label = to_rgl(fit, tmp_path / "a.bsdf", channel="630nm", resolution=small)
+    by_index = to_rgl(fit, tmp_path / "b.bsdf", channel=1, resolution=small)
+    assert by_label.color == by_index.color == "rgb"  # one channel: grey
+    a, b = (decode(p.read_bytes())["rgb"] for p in (by_label.path, by_index.path))
+    np.testing.assert_array_equal(a, b)
+    with pytest.raises(ArgumentError, match="channel"):
+        to_rgl(fit, tmp_path / "c.bsdf", channel="550nm", resolution=small)
+
+
+def test_cli_writes_and_reports_size_and_time(tmp_path):
+    from typer.testing import CliRunner
+
+    from roughbrdf.cli import app
+
+    out = tmp_path / "paint.bsdf"
+    args = ["export", "coated", "-p", "alpha=0.2", "--to", "rgl", "--out", str(out),
+            "--resolution", "theta_i=4,samples=8,vndf=16,ndf=32"]
+    done = CliRunner().invoke(app, args)
+    assert done.exit_code == 0, done.output
+    assert "MB in" in done.output and "4 incidences x 8x8" in done.output and out.is_file()
+    again = CliRunner().invoke(app, args)
+    assert again.exit_code != 0 and "--force" in again.output
+    bad = CliRunner().invoke(app, [*args[:-1], "samples=1", "--force"])
+    assert bad.exit_code != 0 and "--resolution" in bad.output
+    wrong = CliRunner().invoke(app, ["export", "coated", "--to", "zemax", "--out",
+                                     str(tmp_path / "z.bsdf"), "--color", "rgb"])
+    assert wrong.exit_code != 0 and "--color" in wrong.output

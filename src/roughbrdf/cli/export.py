@@ -1,6 +1,7 @@
 """``roughbrdf export (MODEL -p ... | --fit DIR) --to TARGET --out PATH``.
 
-Targets: zemax, mitsuba, mitsuba-xml, lighttools, zemax-abg (:data:`roughbrdf.export.TARGETS`).
+Targets: zemax, mitsuba, mitsuba-xml, lighttools, zemax-abg, rgl
+(:data:`roughbrdf.export.TARGETS`).
 
 Writes a model, or the fitted models of a saved fit (``fit.json``), for another tool
 (:func:`roughbrdf.export.export`, ``docs/export.md``): a Zemax OpticStudio tabular BSDF
@@ -14,6 +15,9 @@ printed. A model that reflects more than it receives (albedo above 1 + 1e-3 at a
 Nothing is replaced without ``--force``; every file is written atomically. The folder of
 ``--fit`` is checked first (:func:`roughbrdf.result_check.check_result_folder`): a write cut
 off by a kill is completed or undone, a folder being written or changed since is refused.
+
+``--to rgl`` writes an RGL measured-BSDF tensor file (Mitsuba 3's ``measured``; its options
+``--color`` and ``--resolution``) and prints its size and the time taken.
 """
 
 from __future__ import annotations
@@ -28,7 +32,8 @@ from .common import EXPORT_OPTIONS, cli_model, degree_range, handled, parse_para
 from .options import pick_channel
 
 #: the library's argument names -> this verb's options (errors name the options)
-OPTIONS = {**EXPORT_OPTIONS, "allow_energy_gain": "--allow-energy-gain"}
+OPTIONS = {**EXPORT_OPTIONS, "allow_energy_gain": "--allow-energy-gain", "color": "--color",
+           "resolution": "--resolution"}
 
 
 def _source(model: str | None, param: list[str] | None, fit_dir: str | None,
@@ -75,15 +80,50 @@ def _zemax_options(incidences: str | None, radial: str | None, azimuth: str | No
     return opts
 
 
+def _rgl_options(grid: dict[str, Any], rgb: bool | None, fit_closest: bool,
+                 theta_max: float | None, allow_energy_gain: bool, color: str | None,
+                 resolution: str | None) -> dict[str, Any]:
+    """``--to rgl``'s options: ``--color`` and ``--resolution KEY=N,...``; the other targets'
+    options refused, naming them."""
+    if grid or rgb is not None or fit_closest or theta_max is not None or allow_energy_gain:
+        raise ValueError("--incidences, --radial, --azimuth, --symmetry, --rgb/--no-rgb, "
+                         "--fit-closest, --theta-max and --allow-energy-gain do not apply to "
+                         "--to rgl (its options: --color, --resolution)")
+    options: dict[str, Any] = {}
+    if color is not None:
+        options["color"] = color.strip().lower()
+    if resolution is not None:
+        sizes: dict[str, Any] = {}
+        for part in filter(None, (p.strip() for p in resolution.split(","))):
+            key, sep, value = part.partition("=")
+            key = key.strip().replace("-", "_")
+            if not sep or key not in ("theta_i", "samples", "vndf", "ndf", "theta_i_max"):
+                raise ValueError(f"--resolution takes KEY=VALUE,... with keys theta_i, "
+                                 f"samples, vndf, ndf, theta_i_max (degrees); got {part!r}")
+            try:
+                sizes[key] = (math.radians(float(value)) if key == "theta_i_max"
+                              else int(value))
+            except ValueError:
+                raise ValueError(f"--resolution {key}: not a number: {value!r}") from None
+        options["resolution"] = sizes
+    return options
+
+
 def run_export(model: str | None, param: list[str] | None, fit_dir: str | None, to: str,
                out: str, *, channel: str | None, force: bool, grid: dict[str, Any],
                rgb: bool | None, fit_closest: bool, theta_max: float | None,
-               allow_energy_gain: bool = False) -> None:
+               allow_energy_gain: bool = False, color: str | None = None,
+               resolution: str | None = None) -> None:
     """The work of ``roughbrdf export``: checked, written, reported."""
     from ..export import export, target_name
 
     target = target_name(to)
-    if target in ("lighttools", "zemax-abg"):
+    if target != "rgl" and (color is not None or resolution is not None):
+        raise ValueError("--color and --resolution apply to --to rgl")
+    if target == "rgl":
+        options = _rgl_options(grid, rgb, fit_closest, theta_max, allow_energy_gain, color,
+                               resolution)
+    elif target in ("lighttools", "zemax-abg"):
         if rgb is not None or fit_closest or theta_max is not None:
             raise ValueError("--rgb/--no-rgb, --fit-closest and --theta-max apply to the "
                              "Mitsuba targets")
@@ -115,8 +155,9 @@ def run_export(model: str | None, param: list[str] | None, fit_dir: str | None, 
     if channel is not None and isinstance(source, dict) and not source.get("per_incidence"):
         labels = list(source)  # a fit's {channel: model}: a label or an index, checked here
         chan = labels[pick_channel([str(k) for k in labels], channel)]
-    res = export(source, Path(out), to=target, overwrite=force, channel=chan,
-                 allow_energy_gain=allow_energy_gain, **options)
+    if target != "rgl":
+        options["allow_energy_gain"] = allow_energy_gain
+    res = export(source, Path(out), to=target, overwrite=force, channel=chan, **options)
     typer.echo(res.report)
     for path in res.paths:  # one "wrote" line per file: those the report has not given
         if not any(line.startswith(f"wrote {path}") for line in res.report.splitlines()):
@@ -131,7 +172,8 @@ def register(app: typer.Typer) -> None:
                  "(or --fit DIR)")] = None,
         to: str = typer.Option(..., "--to", help="zemax (.bsdf), mitsuba (dict as JSON), "
                                                  "mitsuba-xml (<bsdf>), lighttools (.bsdf) "
-                                                 "or zemax-abg (ABg catalog values, .txt)"),
+                                                 "zemax-abg (ABg catalog values, .txt) or "
+                                                 "rgl (RGL measured BSDF, .bsdf)"),
         out: str = typer.Option(..., "--out", "-o", help="the file (Zemax: one per channel "
                                                           "of a fit, <stem>_<channel>.bsdf)"),
         param: Annotated[list[str] | None, typer.Option(
@@ -163,16 +205,23 @@ def register(app: typer.Typer) -> None:
         theta_max: float = typer.Option(None, "--theta-max", metavar="DEG",
                                         help="Mitsuba: largest angle of the deviation grid "
                                              "(default 80)"),
+        color: str = typer.Option(None, "--color", metavar="rgb|spectral",
+                                  help="RGL: RGB file (Mitsuba's RGB variants) or spectral "
+                                       "(default when the channels are wavelengths)"),
+        resolution: str = typer.Option(None, "--resolution", metavar="KEY=N,...",
+                                       help="RGL: grid sizes theta_i (24), samples (48), vndf "
+                                            "(64), ndf (256), theta_i_max (88 deg)"),
         force: bool = typer.Option(False, "--force", help="replace existing files"),
         allow_energy_gain: bool = typer.Option(
             False, "--allow-energy-gain",
             help="export a model that reflects more than it receives (albedo > 1 at some "
                  "incidence; refused by default), recorded in the file"),
     ) -> None:
-        """Export a model or a fit to Zemax OpticStudio (.bsdf, ABg values), LightTools (.bsdf)
-        or Mitsuba 3 (dict, XML)."""
+        """Export a model or a fit to Zemax OpticStudio (.bsdf, ABg values), LightTools (.bsdf),
+        Mitsuba 3 (dict, XML) or an RGL measured BSDF (.bsdf)."""
         with handled(OPTIONS):
             run_export(model, param, fit_dir, to, out, channel=channel, force=force,
                        grid=_zemax_options(incidences, radial, azimuth, symmetry), rgb=rgb,
                        fit_closest=fit_closest, theta_max=theta_max,
-                       allow_energy_gain=allow_energy_gain)
+                       allow_energy_gain=allow_energy_gain, color=color,
+                       resolution=resolution)

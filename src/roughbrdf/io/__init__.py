@@ -9,14 +9,18 @@ merl        ``.binary``, ``.merl``  :mod:`roughbrdf.io.merl` (MERL 2003 binary) 
 csv         ``.csv``                :mod:`roughbrdf.io.csv` (roughbrdf CSV)           yes   yes
 zemax       ``.bsdf``               :mod:`roughbrdf.io.zemax` (Zemax tabular BSDF)    yes   yes
 lighttools  ``.bsdf``               :mod:`roughbrdf.io.lighttools` (LightTools BSDF)  yes   yes
+rgl         ``.bsdf``               :mod:`roughbrdf.io.rgl` (RGL tensor file)         yes   no
 ==========  ======================  ================================================  ====  =====
 
 ``read(path)`` chooses the format from the extension (``format=`` overrides); when the
-extension is unknown it looks at the first bytes. Zemax and LightTools share ``.bsdf``: an
-existing ``.bsdf`` file is read by its contents (:func:`roughbrdf.io.lighttools.sniff_bsdf`),
-a new one is written as Zemax unless ``format="lighttools"``. Every problem with a file raises
-:class:`FormatError` (a ``ValueError``) whose message starts with the path and, where one line is
-at fault, the line number (also in ``.path`` and ``.line``).
+extension is unknown it looks at the first bytes. Zemax, LightTools and RGL share ``.bsdf``:
+an existing ``.bsdf`` file is read by its contents (an RGL tensor file by its magic bytes
+``tensor_file``, :func:`roughbrdf.io.rgl.sniff`; then
+:func:`roughbrdf.io.lighttools.sniff_bsdf`), a new one is written as Zemax unless
+``format="lighttools"`` (RGL files are written by ``roughbrdf.export``, ``to="rgl"``).
+Every problem with a file raises :class:`FormatError` (a ``ValueError``) whose message starts
+with the path and, where one line is at fault, the line number (also in ``.path`` and
+``.line``).
 
 Each text reader's ``read()`` runs the same phases - header, angle unit, columns, quantity,
 rows - and every reader applies the same two rules, from :mod:`roughbrdf.io._common`: the angle
@@ -75,7 +79,7 @@ __all__ = ["read", "write", "FormatError", "FormatWarning", "ImplausibleAnglesWa
 #: format name -> module name under roughbrdf.io
 #: (zemax before lighttools: a new .bsdf file is written as Zemax unless told otherwise)
 FORMATS = {"astm": "astm", "alta": "alta", "merl": "merl", "csv": "csv", "zemax": "zemax",
-           "lighttools": "lighttools"}
+           "lighttools": "lighttools", "rgl": "rgl"}
 _ALIASES = {"ascii": "alta", "dat": "alta", "binary": "merl", "e1392": "astm", "txt": "alta",
             "bsdf": "zemax", "opticstudio": "zemax", "lt": "lighttools"}
 
@@ -112,6 +116,8 @@ def _sniff(path: Path) -> str | None:
             head = fh.read(4096)
     except OSError:
         return None
+    if head.startswith(b"tensor_file\0"):  # the RGL tensor file's magic (roughbrdf.io.rgl)
+        return "rgl"
     if size >= 12:
         import numpy as np
 
@@ -166,7 +172,7 @@ def read(path: str | os.PathLike, format: str | None = None, **options: Any) -> 
     Parameters
     ----------
     path : str or path-like
-    format : {"astm", "alta", "merl", "csv", "zemax", "lighttools"}, optional
+    format : {"astm", "alta", "merl", "csv", "zemax", "lighttools", "rgl"}, optional
         Override the format chosen from the extension (a ``.bsdf`` file: by its contents).
     **options
         Passed to the format's reader, e.g. ``quantity="brdf_cos"`` (ALTA without
@@ -193,10 +199,11 @@ def read(path: str | os.PathLike, format: str | None = None, **options: Any) -> 
     if not p.exists():
         raise FileNotFoundError(f"{p}: no such file")
     fmt = format_for(p, format)
-    if format is None and p.suffix.lower() == ".bsdf":  # Zemax or LightTools: by content
+    if format is None and p.suffix.lower() == ".bsdf":  # Zemax, LightTools or RGL: by content
         from .lighttools import sniff_bsdf
+        from .rgl import sniff
 
-        fmt = sniff_bsdf(p)
+        fmt = "rgl" if sniff(p) else sniff_bsdf(p)
     measurement = _module(fmt).read(p, **options)
     # samples the instrument's software filled in (roughbrdf.extrapolation): recorded in meta,
     # left out by fits unless asked; the values are not changed

@@ -166,7 +166,12 @@ def test_spectral_file_of_a_fit_loads_in_a_spectral_variant(tmp_path):
     np.testing.assert_allclose(got, ref, rtol=0.03)
     rgb = export(truth, tmp_path / "c.bsdf", to="rgl", color="rgb")
     assert rgb.detail.channels == ["R", "G", "B"]
-    assert "rgb" in decode(rgb.paths[0].read_bytes())
+    # R, G, B: the channels interpolated linearly in wavelength at 612, 549 and 465 nm
+    spec, col = f["spectra"][0], decode(rgb.paths[0].read_bytes())["rgb"][0]
+    for c, nm in enumerate((612.0, 549.0, 465.0)):
+        k = (nm - 525.0) / (630.0 - 525.0)
+        want = spec[:, 0] if nm < 525 else (1 - k) * spec[:, 1] + k * spec[:, 2]
+        np.testing.assert_allclose(col[:, c], want, rtol=1e-5, atol=1e-9)
 
 
 def test_refuses_to_overwrite_and_names_bad_arguments(tmp_path):

@@ -190,7 +190,13 @@ def test_refuses_to_overwrite_and_names_bad_arguments(tmp_path):
         to_rgl(MODELS["abg"], tmp_path / "y.bsdf", color="cmyk")
     with pytest.raises(ArgumentError, match="channel"):
         to_rgl(MODELS["abg"], tmp_path / "y.bsdf", channel=0)
+    gain = rb.model("microfacet", alpha=0.3, n=None, k=None, ks=1.5)  # albedo above 1
+    with pytest.raises(ArgumentError, match="allow_energy_gain"):
+        to_rgl(gain, tmp_path / "y.bsdf", resolution=small)
     assert not (tmp_path / "y.bsdf").exists()
+    done = to_rgl(gain, tmp_path / "y.bsdf", resolution=small, allow_energy_gain=True)
+    text = bytes(decode(done.path.read_bytes())["description"]).decode()
+    assert "allow_energy_gain: exported although" in text
 
 
 def test_one_channel_of_a_fit_by_label_or_index(tmp_path):

@@ -81,14 +81,14 @@ def _zemax_options(incidences: str | None, radial: str | None, azimuth: str | No
 
 
 def _rgl_options(grid: dict[str, Any], rgb: bool | None, fit_closest: bool,
-                 theta_max: float | None, allow_energy_gain: bool, color: str | None,
+                 theta_max: float | None, color: str | None,
                  resolution: str | None) -> dict[str, Any]:
     """``--to rgl``'s options: ``--color`` and ``--resolution KEY=N,...``; the other targets'
     options refused, naming them."""
-    if grid or rgb is not None or fit_closest or theta_max is not None or allow_energy_gain:
+    if grid or rgb is not None or fit_closest or theta_max is not None:
         raise ValueError("--incidences, --radial, --azimuth, --symmetry, --rgb/--no-rgb, "
-                         "--fit-closest, --theta-max and --allow-energy-gain do not apply to "
-                         "--to rgl (its options: --color, --resolution)")
+                         "--fit-closest and --theta-max do not apply to --to rgl (its "
+                         "options: --color, --resolution)")
     options: dict[str, Any] = {}
     if color is not None:
         options["color"] = color.strip().lower()
@@ -121,8 +121,7 @@ def run_export(model: str | None, param: list[str] | None, fit_dir: str | None, 
     if target != "rgl" and (color is not None or resolution is not None):
         raise ValueError("--color and --resolution apply to --to rgl")
     if target == "rgl":
-        options = _rgl_options(grid, rgb, fit_closest, theta_max, allow_energy_gain, color,
-                               resolution)
+        options = _rgl_options(grid, rgb, fit_closest, theta_max, color, resolution)
     elif target in ("lighttools", "zemax-abg"):
         if rgb is not None or fit_closest or theta_max is not None:
             raise ValueError("--rgb/--no-rgb, --fit-closest and --theta-max apply to the "
@@ -155,9 +154,8 @@ def run_export(model: str | None, param: list[str] | None, fit_dir: str | None, 
     if channel is not None and isinstance(source, dict) and not source.get("per_incidence"):
         labels = list(source)  # a fit's {channel: model}: a label or an index, checked here
         chan = labels[pick_channel([str(k) for k in labels], channel)]
-    if target != "rgl":
-        options["allow_energy_gain"] = allow_energy_gain
-    res = export(source, Path(out), to=target, overwrite=force, channel=chan, **options)
+    res = export(source, Path(out), to=target, overwrite=force, channel=chan,
+                 allow_energy_gain=allow_energy_gain, **options)
     typer.echo(res.report)
     for path in res.paths:  # one "wrote" line per file: those the report has not given
         if not any(line.startswith(f"wrote {path}") for line in res.report.splitlines()):

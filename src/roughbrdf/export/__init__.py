@@ -111,10 +111,11 @@ def export(source: Any, out: str | os.PathLike, *, to: str, overwrite: bool = Fa
         :class:`~roughbrdf.export.grids.TableAccuracyWarning` when they miss it); Mitsuba
         ``rgb``, ``fit``, ``theta_max`` (:func:`~roughbrdf.export.mitsuba.export_mitsuba`);
         RGL ``color``, ``resolution``, ``description`` (:func:`~roughbrdf.export.rgl.to_rgl`);
-        both ``allow_energy_gain``: a model whose albedo exceeds ``1 + 1e-3`` at an incidence
+        all ``allow_energy_gain``: a model whose albedo exceeds ``1 + 1e-3`` at an incidence
         of 0, 5, ... 85, 89 deg is refused (an :class:`~roughbrdf.errors.ArgumentError`
         naming the albedo and the incidence) unless it is True, which the file records (a
-        Zemax header comment, an XML comment, the JSON key :data:`ENERGY_NOTE_KEY`).
+        Zemax header comment, an XML comment, the JSON key :data:`ENERGY_NOTE_KEY`, the RGL
+        file's ``description``).
 
     Returns
     -------

@@ -114,6 +114,7 @@ def _slice(fields: dict[str, np.ndarray], k: int, spec: np.ndarray,
         values = values * (bilinear(fields["ndf"].astype(float), x, y) / (4 * sigma))[:, None]
     keep = wo[2] > math.sin(_HORIZON)
     cos_o = wo[2][keep]
+    # clip: a unit vector's z may round beyond 1, where arccos is NaN
     return (np.arccos(np.clip(cos_o, -1.0, 1.0)), np.angle(-(wo[0] + 1j * wo[1]))[keep],
             values[keep] / cos_o[:, None])
 
@@ -152,6 +153,7 @@ def read(path: str | os.PathLike, *, quantity: Any = None, angles: Any = None) -
     description = bytes(fields["description"].astype(np.uint8)).decode("utf-8", "replace")
     meta = {"file": str(p), "format": "rgl", "description": description,
             "jacobian": jacobian}
+    # the float32 theta_i nodes are in [0, pi/2] up to rounding, which the Measurement refuses
     return Measurement(theta_i=np.clip(ti, 0.0, math.pi / 2),
                        theta_r=np.concatenate([part[0] for part in parts]),
                        phi=np.concatenate([part[1] for part in parts]),

@@ -133,6 +133,7 @@ def u_to_theta(u):
 
 def theta_to_u(theta):
     """Unit coordinate of a zenith: ``sqrt(2 theta / pi)``."""
+    # a zenith a rounding below 0 (acos of a float just above 1) is the normal, not a NaN
     return np.sqrt(np.maximum(theta, 0.0) * (2 / np.pi))
 
 
@@ -151,6 +152,8 @@ def bilinear(table: np.ndarray, x, y) -> np.ndarray:
     """``table[row, col]`` on the unit square's vertex grid, interpolated bilinearly at
     ``(x, y)`` (x along the columns) - Mitsuba's ``Marginal2D::eval`` without normalization."""
     h, w = table.shape
+    # outside the square (rounding) the edge's value, and the last cell holds the far edge:
+    # Mitsuba's clamps, so that both read the same value there
     px = np.clip(np.asarray(x, float), 0.0, 1.0) * (w - 1)
     py = np.clip(np.asarray(y, float), 0.0, 1.0) * (h - 1)
     ix = np.minimum(px.astype(np.int64), w - 2)
@@ -170,7 +173,7 @@ def _segment(t, scale: float, v0, v1):
     den = v0 + disc
     # den == 0: both ends 0 (an empty cell, reached only by rounding): its start
     x = np.divide(two_t, den, out=np.zeros_like(den), where=den > 0)
-    return np.clip(x, 0.0, 1.0)
+    return np.clip(x, 0.0, 1.0)  # rounding may step a hair outside the cell
 
 
 def sample_marginal(data: np.ndarray, sx, sy) -> tuple[np.ndarray, np.ndarray]:
@@ -201,13 +204,14 @@ def sample_marginal(data: np.ndarray, sx, sy) -> tuple[np.ndarray, np.ndarray]:
     eps = float(np.finfo(np.float32).eps) / 2
     sy = np.clip(np.asarray(sy, float), eps, 1 - eps)
     sx = np.clip(np.asarray(sx, float), eps, 1 - eps)
+    # the first row whose CDF reaches sy; sy above the last entry (rounding): the last row
     row = np.minimum(np.searchsorted(marg, sy, side="left"), h - 2)
     below = np.where(row > 0, marg[np.maximum(row - 1, 0)], 0.0)
     r0, r1 = rows[row], rows[row + 1]
     fy = _segment(sy - below, float(h - 1), r0, r1)
     sx = sx * (r0 + (r1 - r0) * fy)
     crow = cond[row] * (1 - fy)[:, None] + cond[row + 1] * fy[:, None]  # (n, w-1)
-    col = np.minimum((crow < sx[:, None]).sum(axis=1), w - 2)
+    col = np.minimum((crow < sx[:, None]).sum(axis=1), w - 2)  # as for the row
     left = np.where(col > 0, np.take_along_axis(crow, np.maximum(col - 1, 0)[:, None],
                                                 axis=1)[:, 0], 0.0)
     c0 = v[row, col] * (1 - fy) + v[row + 1, col] * fy

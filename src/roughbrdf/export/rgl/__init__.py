@@ -146,7 +146,7 @@ def _mixing(labels: list[str], color: str) -> tuple[np.ndarray, list[str], list[
 def to_rgl(source: Any, out: str | os.PathLike, *, channel: int | str | None = None,
            overwrite: bool = False, color: str | None = None,
            resolution: Resolution | Mapping[str, Any] | None = None,
-           description: str | None = None) -> RglExport:
+           description: str | None = None, allow_energy_gain: bool = False) -> RglExport:
     """Write an RGL measured-BSDF tensor file (``.bsdf``) of a model or a fit.
 
     Parameters
@@ -165,6 +165,10 @@ def to_rgl(source: Any, out: str | os.PathLike, *, channel: int | str | None = N
         Grid sizes (:class:`~roughbrdf.export.rgl.build.Resolution`; a mapping of its fields).
     description : str, optional
         Text for the file's ``description`` (default: the model); the NDF's source is added.
+    allow_energy_gain : bool
+        Write a model whose albedo exceeds ``1 + 1e-3`` at an incidence of 0, 5, ... 85,
+        89 deg (refused by default, an :class:`~roughbrdf.errors.ArgumentError` naming it, as
+        by every export), recorded in the ``description``.
 
     Returns
     -------
@@ -181,6 +185,7 @@ def to_rgl(source: Any, out: str | os.PathLike, *, channel: int | str | None = N
     >>> "power iteration" in done.ndf_source
     True
     """
+    from ...fitting.results.plausibility import refuse_energy_gain
     from ...io.rgl_tensor import encode
     from ...output import atomic_write, refuse_existing
 
@@ -196,8 +201,10 @@ def to_rgl(source: Any, out: str | os.PathLike, *, channel: int | str | None = N
         raise ArgumentError("color", "must be 'rgb' or 'spectral'", value=color)
     mix, names, waves = _mixing(labels, color)
     models = [m for _, m in pairs]
+    notes = refuse_energy_gain(dict(pairs), allow_energy_gain)
     text = description if description is not None else \
         f"roughbrdf export of {models[0]!r}" + (f" ({', '.join(labels)})" if labels[0] else "")
+    text = " ".join([text, *notes])
     fields, source_ndf = build_fields(models, res, rgb=color == "rgb", mix=mix,
                                       wavelengths=waves, description=text)
     blob = encode(fields)

@@ -65,6 +65,15 @@ class Resolution:
         Nodes of the NDF and sigma tables (zenith, ``u``).
     theta_i_max : float
         The last incidence zenith, radians.
+
+    Examples
+    --------
+    >>> Resolution(samples=64).samples, Resolution().theta_i
+    (64, 24)
+    >>> Resolution(samples=1).check()
+    Traceback (most recent call last):
+    ...
+    ValueError: resolution samples must be an integer >= 2, got 1
     """
 
     theta_i: int = 24
@@ -107,9 +116,11 @@ def _geometry(theta_i: float, vndf: np.ndarray, n: int) -> dict[str, np.ndarray]
     wi = np.array([np.sin(theta_i), 0.0, np.cos(theta_i)])[:, None]
     wo = 2.0 * (wi * m).sum(axis=0) * m - wi
     cos_o = wo[2]
-    theta_r = np.arccos(np.clip(cos_o, -1.0, 1.0))
+    theta_r = np.arccos(np.clip(cos_o, -1.0, 1.0))  # |z| may round beyond 1: NaN otherwise
     # the incident direction's azimuth is 0, so the forward (specular) side is at pi
     phi = np.angle(-(wo[0] + 1j * wo[1]))
+    # below the horizon (cos_o <= 0) the node holds 0 and the model is not evaluated; theta_r
+    # is capped only so that every entry is a valid zenith
     return {"u": x, "theta_r": np.minimum(theta_r, np.pi / 2), "phi": phi, "cos_o": cos_o}
 
 
@@ -133,6 +144,22 @@ def build_fields(models: list, res: Resolution, *, rgb: bool, mix: np.ndarray | 
         The channels' wavelengths (nm) of a spectral file.
     description : str
         The text of the ``description`` field (the NDF's source is appended).
+
+    Returns
+    -------
+    fields : dict of str to ndarray
+        In the layout of the table above, for :func:`roughbrdf.io.rgl_tensor.encode`.
+    source : str
+        Where the NDF came from (:data:`~roughbrdf.export.rgl.ndf.EXACT_SOURCE` or
+        :data:`~roughbrdf.export.rgl.ndf.POWER_SOURCE`).
+
+    Examples
+    --------
+    >>> import roughbrdf as rb
+    >>> small = Resolution(theta_i=3, samples=8, vndf=16, ndf=32)
+    >>> fields, source = build_fields([rb.model("lambertian", rho=0.5)] * 3, small, rgb=True)
+    >>> fields["rgb"].shape, fields["vndf"].shape, source.split()[0]
+    ((1, 3, 3, 8, 8), (1, 3, 16, 16), 'power')
     """
     res.check()
     u, d, source = ndf_table(models, res.ndf)
@@ -152,6 +179,8 @@ def build_fields(models: list, res: Resolution, *, rgb: bool, mix: np.ndarray | 
     values = np.zeros((len(models), ti.size))  # f_r cos(theta_o)
     for c, model in enumerate(models):  # one vectorized evaluation per channel
         f = np.asarray(model.brdf(ti[above], tr[above], ph[above]), float)
+        # a model undefined at a node (NaN, e.g. exactly grazing) or infinite there (a delta)
+        # has no finite table value: 0 keeps the tables (and the warps built from them) finite
         values[c, above] = np.nan_to_num(f, nan=0.0, posinf=0.0) * cos_o[above]
     values = np.maximum(values, 0.0)  # a model's rounding below 0 is no reflectance
     if mix is not None:

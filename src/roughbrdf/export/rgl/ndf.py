@@ -75,6 +75,8 @@ def _exact(models: list) -> Callable[[np.ndarray], np.ndarray] | None:
 def _phi_integral(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``int_0^{2 pi} max(0, a cos(phi) + b) dphi`` for ``a >= 0`` (closed form)."""
     with np.errstate(invalid="ignore", divide="ignore"):
+        # a = 0 (the normal, or m at the normal): the integrand is constant, the "full" branch
+        # below; the clip and the max keep the unused branch free of NaN where |b| >= a
         ratio = np.clip(np.divide(-b, a, out=np.zeros_like(b), where=a > 0), -1.0, 1.0)
         part = 2.0 * (b * np.arccos(ratio) + np.sqrt(np.maximum(a * a - b * b, 0.0)))
     full = np.where(b > 0, 2 * np.pi * b, 0.0)
@@ -116,12 +118,13 @@ def ndf_table(models: list, n: int) -> tuple[np.ndarray, np.ndarray, str]:
     theta = np.minimum(u_to_theta(u), _THETA_TOP)
     exact = _exact(models)
     if exact is not None:
+        # NaN/inf (a distribution's far tail or rounding) carry no density: 0, then floored
         d = np.nan_to_num(np.asarray(exact(np.cos(theta)), float), nan=0.0, posinf=0.0)
         if np.max(d) > 0:
             return u, _normalized(u, d), EXACT_SOURCE
     retro = np.mean([np.nan_to_num(np.asarray(m.brdf(theta, theta, np.pi), float), nan=0.0,
                                    posinf=0.0) for m in models], axis=0)
-    retro = np.maximum(retro, 0.0)
+    retro = np.maximum(retro, 0.0)  # NaN/inf/negative (rounding) back-scatter: no density
     if not np.max(retro) > 0:
         raise ValueError(f"{models[0]!r} scatters nothing back towards the source: no NDF can be "
                          "retrieved by power iteration")

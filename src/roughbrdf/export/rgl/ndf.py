@@ -83,17 +83,27 @@ def _phi_integral(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.where(a > np.abs(b), part, full)
 
 
-def sigma_table(u_nodes: np.ndarray, d_nodes: np.ndarray, u_out: np.ndarray) -> np.ndarray:
-    """``sigma(theta) = int D(m) <w, m>+ dm`` at the zeniths ``u_to_theta(u_out)``, for the
-    isotropic ``D`` interpolated linearly in ``u`` from ``(u_nodes, d_nodes)``."""
+def _kernel(u_out: np.ndarray) -> np.ndarray:
+    """``K[o, q]``: the weight of the quadrature node ``q`` (midpoints in ``u``) in
+    ``sigma(theta_o)``, the azimuth integral of ``<w, m>+`` in closed form times
+    ``dm = sin(theta) dtheta dphi`` with ``dtheta = pi u du`` - geometry only, so that an
+    iteration reuses it."""
     uq = (np.arange(_QUAD) + 0.5) / _QUAD
     tq = u_to_theta(uq)
-    # dm = sin(theta) dtheta dphi and dtheta = pi u du: the weight of each u-interval
-    w = np.interp(uq, u_nodes, d_nodes) * np.sin(tq) * np.pi * uq / _QUAD
     to = u_to_theta(np.asarray(u_out, float))[:, None]
     a = np.sin(to) * np.sin(tq)[None, :]
     b = np.cos(to) * np.cos(tq)[None, :]
-    return (_phi_integral(a, b) * w[None, :]).sum(axis=1)
+    return _phi_integral(a, b) * (np.sin(tq) * np.pi * uq / _QUAD)[None, :]
+
+
+def sigma_table(u_nodes: np.ndarray, d_nodes: np.ndarray, u_out: np.ndarray,
+                kernel: np.ndarray | None = None) -> np.ndarray:
+    """``sigma(theta) = int D(m) <w, m>+ dm`` at the zeniths ``u_to_theta(u_out)``, for the
+    isotropic ``D`` interpolated linearly in ``u`` from ``(u_nodes, d_nodes)`` (``kernel``:
+    :func:`_kernel` of ``u_out``, if already computed)."""
+    uq = (np.arange(_QUAD) + 0.5) / _QUAD
+    k = _kernel(u_out) if kernel is None else kernel
+    return k @ np.interp(uq, u_nodes, d_nodes)
 
 
 def _normalized(u: np.ndarray, d: np.ndarray) -> np.ndarray:
@@ -150,8 +160,9 @@ def power_iteration(models: list, u: np.ndarray) -> np.ndarray:
         raise ValueError(f"{models[0]!r} scatters nothing back towards the source: no NDF can be "
                          "retrieved by power iteration")
     d = _normalized(u, retro * np.cos(theta) ** 2)  # start: f(w, w) cos^2 (Dupuy et al.)
+    kernel = _kernel(u)
     for _ in range(_ITERATIONS):
-        sigma = sigma_table(u, d, u)
+        sigma = sigma_table(u, d, u, kernel)
         new = _normalized(u, retro * sigma ** 2)
         done = np.max(np.abs(new - d)) <= 1e-6 * np.max(d)
         d = new

@@ -202,9 +202,14 @@ def to_rgl(source: Any, out: str | os.PathLike, *, channel: int | str | None = N
     mix, names, waves = _mixing(labels, color)
     models = [m for _, m in pairs]
     notes = refuse_energy_gain(dict(pairs), allow_energy_gain)
-    text = description if description is not None else \
-        f"roughbrdf export of {models[0]!r}" + (f" ({', '.join(labels)})" if labels[0] else "")
-    text = " ".join([text, *notes])
+    if description is not None:
+        text = description
+    elif len(models) == 1:
+        text = f"roughbrdf export of {models[0]!r}" + (f" ({labels[0]})" if labels[0] else "")
+    else:  # the channels' parameters differ: name the model, not one channel's values
+        text = (f"roughbrdf export of a {getattr(models[0], 'name', 'model')} fit, channels "
+                f"{', '.join(labels)}")
+    text = "; ".join([text, *notes])
     fields, source_ndf = build_fields(models, res, rgb=color == "rgb", mix=mix,
                                       wavelengths=waves, description=text)
     blob = encode(fields)

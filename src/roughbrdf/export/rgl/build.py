@@ -195,7 +195,7 @@ def build_fields(models: list, res: Resolution, *, rgb: bool, mix: np.ndarray | 
     empty = lum.reshape(res.theta_i, -1).max(axis=1) <= 0
     lum[0, empty] = 1.0  # a black incidence: uniform sampling (a zero density cannot be warped)
     samples = values.reshape(n_out, *shape).transpose(1, 2, 0, 3, 4)
-    text = (description + " " if description else "") + f"NDF: {source}."
+    text = (description + "; " if description else "") + f"NDF: {source}."
     fields = {
         "description": np.frombuffer(text.encode(), np.uint8).copy(),
         "jacobian": np.array([1], np.uint8),

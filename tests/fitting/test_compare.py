@@ -272,16 +272,19 @@ def test_compare_bad_candidates(cands):
     assert info.value.argument == "candidates"
 
 
-def _candidate(label: str, cv: float | None, bic: float, albedo: float = 0.5):
-    """A Candidate of a stand-in result (one channel of the given maximum albedo): the
-    ranking reads only the score, the BIC and the albedo."""
+def _candidate(label: str, cv: float | None, bic: float, albedo: float = 0.5,
+               limited: bool = False):
+    """A Candidate of a stand-in result (one channel of the given maximum albedo, a parameter
+    on a search limit or not): the ranking reads only the score, the BIC, the albedo and the
+    search limit."""
     from types import SimpleNamespace
 
     from roughbrdf.fitting.choice.compare import Candidate
 
     plaus = SimpleNamespace(max_albedo=albedo)
     chan = SimpleNamespace(channel="c", model=rb.model("lambertian"), free=["rho"], params={})
-    res = SimpleNamespace(channels=[chan], options={}, plausibility=lambda i: plaus)
+    res = SimpleNamespace(channels=[chan], options={}, plausibility=lambda i: plaus,
+                          at_search_limit=limited)
     return Candidate(label, res, 3, 100, bic, bic, 0.1, 0.1, {}, cv)
 
 
@@ -307,6 +310,26 @@ def test_rank_by_score_bic_beside_energy_gain_last():
     # NaN (a single incidence) is no score either
     ranked, criterion = rank([_candidate("a", math.nan, -10.0), _candidate("b", 0.1, -5.0)])
     assert criterion == "bic" and [c.label for c in ranked] == ["a", "b"]
+
+
+def test_a_candidate_on_a_search_limit_ranks_after_those_without():
+    # a search limit is where the search stopped, not a result (docs/fitting.md, "Model
+    # choice"): the best score on a search limit ranks after every candidate without one, and
+    # before one that gains energy; a note says so
+    from roughbrdf.fitting.choice.compare import ModelComparison, choice_notes, rank
+
+    rows = [_candidate("a", 0.30, -900.0), _candidate("b", 0.20, -950.0, limited=True),
+            _candidate("c", 0.10, -990.0, albedo=4.0), _candidate("d", 0.25, -600.0)]
+    ranked, criterion = rank(rows)
+    assert criterion == "cv" and [c.label for c in ranked] == ["d", "a", "b", "c"]
+    notes = choice_notes(ModelComparison(ranked, None, criterion=criterion))  # type: ignore
+    assert any(n.startswith("b: a parameter on a search limit") for n in notes), notes
+    # all on a search limit: by the score, no note
+    rows = [_candidate("a", 0.3, -1.0, limited=True), _candidate("b", 0.2, -1.0, limited=True)]
+    ranked, _ = rank(rows)
+    assert [c.label for c in ranked] == ["b", "a"]
+    notes = choice_notes(ModelComparison(ranked, None, criterion="cv"))  # type: ignore
+    assert not any("search limit" in n for n in notes)
 
 
 @pytest.mark.parametrize(("w2", "off"), [(0.0, 2), (1.0, 1)])

@@ -9,7 +9,8 @@ choice"):
 
 1. every candidate is fitted to the first channel, with that channel's held-out residuals;
 2. a candidate whose first-channel score is more than :data:`SKIP_MARGIN` above the best
-   first-channel score (of the candidates whose fit does not gain energy) is not fitted
+   first-channel score (of the candidates whose fit neither gains energy nor has a parameter
+   on a search limit) is not fitted
    further: its row keeps the first channel's figures and says so
    (:attr:`~roughbrdf.fitting.choice.compare.Candidate.partial`), and it ranks after every whole
    candidate. The others are fitted to the remaining channels, the search going on from the
@@ -118,7 +119,10 @@ def _in_two_stages(measurement: Measurement, models: list[Model], options: FitOp
         helds.append(held_out_residuals(res, opt1, label=label, metric=metric))
         first_rows.append(candidate(label, res, rms(helds[-1])))
     scores = [rms(h) for h in helds]
-    sound = [s for s, r in zip(scores, first_rows, strict=True) if not r.gains_energy]
+    # the margin is counted from the best candidate that can be kept: not one that gains
+    # energy or stopped on a search limit (both rank after the others, compare.rank)
+    sound = [s for s, r in zip(scores, first_rows, strict=True)
+             if not r.gains_energy and not r.result.at_search_limit]
     best = min(sound or scores)
     rows: list[Candidate] = []
     for m, first_row, held, score in zip(models, first_rows, helds, scores, strict=True):

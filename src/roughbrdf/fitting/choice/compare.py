@@ -69,7 +69,10 @@ __all__ = ["AUTO_CANDIDATES", "THETA_R_BANDS", "Candidate", "ModelComparison", "
 
 #: the candidates of ``--model auto`` for non-retroreflective materials (paints, plastics,
 #: coatings, ceramics): TR75 as published, then the coated model with one and two specular
-#: lobes (GGX, and Beckmann for peaks that fall faster than GGX's tails). Not among them:
+#: lobes (GGX, and Beckmann for peaks that fall faster than GGX's tails), and the metallic
+#: paints: rough metal flakes with pigment between them, bare and under a clear coat (their
+#: reflectance and edge tint fitted, ``flakes="reflectance"``: the data fix the flakes'
+#: reflectance, rarely their ``n`` and ``k`` apart). Not among them:
 #: RB08 (its retro and bulk terms are for retro-reflectors, and it is slow) and three lobes
 #: (3x the fit time for a small gain on the shared paints); ask for them with ``--models``.
 AUTO_CANDIDATES: tuple[str, ...] = (
@@ -77,6 +80,8 @@ AUTO_CANDIDATES: tuple[str, ...] = (
     "coated",
     "coated(lobes=2)",
     "coated(lobes=2, distribution=beckmann)",
+    "coated-conductor(coat=false, diffuse=true, flakes=reflectance)",
+    "coated-conductor(diffuse=true, flakes=reflectance)",
 )
 
 #: a specular lobe whose weight ends below this is switched off (not counted in ``k``)
@@ -518,16 +523,19 @@ def comparison(rows: list[Candidate], measurement: Measurement, losses: set[str]
 def rank(rows: Sequence[Candidate]) -> tuple[list[Candidate], str]:
     """The candidates best first and the criterion (module notes): ``"cv"`` when every
     candidate has a finite cross-validation score, else ``"bic"``; those that gain energy
-    last; one fitted on part of the channels (:attr:`Candidate.partial`) after every whole
-    one. Ties keep the given order."""
+    last, before them those with a parameter on a search limit (where the search stopped, not
+    a result of the model: ``docs/fitting.md``, "Parameters at a bound"); one fitted on part of
+    the channels (:attr:`Candidate.partial`) after every whole one. Ties keep the given
+    order."""
     cv = all(c.cv is not None and math.isfinite(c.cv) for c in rows)
     criterion = "cv" if cv else "bic"
 
-    def key(c: Candidate) -> tuple[bool, bool, float, int]:
+    def key(c: Candidate) -> tuple[bool, bool, bool, float, int]:
         # equal scores (a lobe switched off: the smaller model's fit): the fewer unknowns;
         # a candidate fitted on the first channel only (skipped) after every whole one
         score = float(f"{c.cv:.6g}") if cv else c.bic  # type: ignore[arg-type]
-        return c.partial is not None, c.gains_energy, score, c.k
+        return (c.partial is not None, c.gains_energy, bool(c.result.at_search_limit), score,
+                c.k)
 
     return sorted(rows, key=key), criterion
 
@@ -556,4 +564,9 @@ def choice_notes(cmp: ModelComparison) -> list[str]:
     if any(c.gains_energy for c in cmp.candidates):
         notes.append("candidates whose fitted model gains energy rank last, whatever their "
                      "score")
+    limited = [c.label for c in cmp.candidates if c.result.at_search_limit]
+    if limited and len(limited) < len(cmp.candidates):
+        notes.append(f"{', '.join(limited)}: a parameter on a search limit (where the search "
+                     f"stopped, not a result): ranked after the candidates without one, "
+                     f"whatever the score")
     return notes

@@ -5,7 +5,9 @@ leave-one-incidence-out score and the energy constraint included) at most 6x one
 fit of the same run (the ratio travels between machines; the absolute time does not).
 
 Printed, warm (the compiled kernels and the lobe-albedo tables built by a first run, not
-counted), best of :data:`REPEAT`: the default ``rb.fit("auto")``, and in the same run the
+counted), best of :data:`REPEAT`: the default ``rb.fit("auto")``; the same with the candidates
+before the metallic ones (:data:`BEFORE_METALLIC`, issue 28: the cost the metallic candidates
+add); and in the same run the
 references that show what each part costs -- without the cross-validation (``cv=False``), without
 the energy constraint -- and one ``coated`` fit; with the CPU, its widest vector unit
 (``avx512f``/``avx2`` in ``/proc/cpuinfo``) and the load average before and after, since a
@@ -32,6 +34,9 @@ HERE = Path(__file__).resolve().parent
 DATA = Path(os.environ.get("ROUGHBRDF_SHARED_DATA", HERE.parent.parent / "shared" / "data"))
 FILE = "C2_Black"
 REPEAT = 2
+#: ``AUTO_CANDIDATES`` before the metallic-paint candidates (2026-12-06)
+BEFORE_METALLIC = ("trowbridge-reitz-1975", "coated", "coated(lobes=2)",
+                   "coated(lobes=2, distribution=beckmann)")
 
 
 def best(call: Callable[[], object]) -> float:
@@ -56,6 +61,8 @@ def main() -> None:
     runs = {
         "rb.fit('auto') (defaults: CV score, energy constraint)":
             lambda: rb.fit("auto", meas, progress=False),
+        "rb.fit('auto'), the candidates before the metallic ones":
+            lambda: fit_auto(meas, BEFORE_METALLIC, progress=False),
         "fit_auto(cv=False) (reference: no CV refits)":
             lambda: fit_auto(meas, cv=False, progress=False),
         "rb.fit('auto', energy_constraint=False) (reference)":

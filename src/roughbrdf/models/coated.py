@@ -435,6 +435,24 @@ class Coated(Model):
             return (("alpha", "alpha2"), ("ks", "ks2")), ()
         return (("alpha", "alpha2"),), ("w2",)
 
+    def lobe_layout(self) -> tuple[str, tuple[str, ...], tuple[str | None, ...]]:
+        """Where the specular lobes are, for the search's starts from the data's peak widths
+        (``roughbrdf.fitting.problem.lobe_starts``): the distribution, each lobe's width
+        parameter and its weight share (``w2``, ``w3``; None for the first lobe, and for every
+        lobe with ``weights="free"``, whose scales are no shares).
+
+        Examples
+        --------
+        >>> import roughbrdf as rb
+        >>> rb.model("coated", lobes=2, distribution="beckmann").lobe_layout()
+        ('beckmann', ('alpha', 'alpha2'), (None, 'w2'))
+        """
+        o = self._options
+        widths = tuple("alpha" if j == 1 else f"alpha{j}" for j in range(1, o["lobes"] + 1))
+        free = o.get("weights") == "free"
+        shares = tuple(None if j == 1 or free else f"w{j}" for j in range(1, o["lobes"] + 1))
+        return o["distribution"], widths, shares
+
     def specular_lobes(self) -> list[tuple[float, float]]:
         """``[(weight, alpha), ...]`` of the specular lobes: the weights of
         :func:`lobe_weights` (they sum to 1), or the free scales ``ks_j`` with

@@ -146,6 +146,9 @@ def _starts_text(c: ChannelFit) -> str:
     notes = []
     if any(s.get("origin") == "previous channel" for s in explored):
         notes.append("1 from the previous channel's optimum")
+    data = sum(s.get("origin") == "data" for s in explored)
+    if data:
+        notes.append(f"{data} from the data's peak widths")
     if polished:
         notes.append(f"on a subsample, the {polished} best refined on all samples")
     return f"{len(explored)}" + (f"  ({'; '.join(notes)})" if notes else "")

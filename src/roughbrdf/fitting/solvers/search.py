@@ -3,7 +3,10 @@
 ``docs/fitting.md`` ("Global search"): exactly ``starts`` local fits
 (``scipy.optimize.least_squares``, trust-region reflective, box bounds) per channel: one from the
 model's own values, one from the previous channel's optimum when there is one and ``starts >=
-2`` (a warm start), and the rest from scrambled Sobol points (:func:`sobol_points`) in the bounds
+2`` (a warm start), for a model with several lobes up to two read off the channel's peaks (a
+narrow lobe at the peak's width, a second at its haze:
+:mod:`~roughbrdf.fitting.problem.lobe_starts`; at least :data:`MIN_SOBOL` Sobol starts are
+kept), and the rest from scrambled Sobol points (:func:`sobol_points`) in the bounds
 of the free parameters, chosen by :func:`screen` among ``screen`` candidates (one model
 evaluation each: the lowest cost, kept at least :data:`SCREEN_DIST` of the bounds apart).
 When a channel has more than ``subsample``
@@ -27,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ...interrupts import held_interrupts
+from ..problem.lobe_starts import MAX_DATA_STARTS, lobe_starts
 from ..problem.objective import Objective, ObjectiveSpec
 from ..problem.search_options import SearchOptions
 from .bounded import bounded_lm, settle
@@ -36,7 +40,7 @@ if TYPE_CHECKING:
 
 __all__ = ["MultiStart", "SearchOptions", "SearchOutcome", "local_fit", "polish_fit",
            "progress_bar", "screen", "sobol_points", "CHOICE_TOL", "EXPLORE_TOL", "POLISH_TOL",
-           "POLISH_ROUND", "POLISHED_TIE", "SCREEN_DIST", "first_best"]
+           "POLISH_ROUND", "POLISHED_TIE", "SCREEN_DIST", "MIN_SOBOL", "first_best"]
 
 #: tolerance (ftol, xtol, gtol) of the exploring local fits
 EXPLORE_TOL = 1e-4
@@ -65,6 +69,9 @@ CHOICE_TOL = 1e-12
 #: with the host's: with 1e-12 the two machines kept different ones
 POLISHED_TIE = 1e-9
 X_SCALE = "jac"
+#: Sobol starts kept when data starts (:mod:`~roughbrdf.fitting.problem.lobe_starts`) take
+#: the others' places: the box is still explored beyond what the data suggest
+MIN_SOBOL = 2
 
 
 @dataclass
@@ -81,7 +88,8 @@ class SearchOutcome:
         Every local fit: ``{"x0", "x", "cost", "stage", "origin"}`` with ``stage``
         ``"single"`` (on all samples, no polish), ``"explore"`` (on the subsample) or ``"full"``
         (polish), and ``origin`` where its start came from: ``"model"`` (the model's values),
-        ``"previous channel"`` (its optimum), ``"sobol"`` or, for a polish, ``"explored"``.
+        ``"previous channel"`` (its optimum), ``"data"`` (the data's peak widths, models with
+        several lobes), ``"sobol"`` or, for a polish, ``"explored"``.
     explore_nfev : int
         Model evaluations of the exploration on the subsample (0 without one).
     """
@@ -297,19 +305,35 @@ class MultiStart:
         """Search one channel; returns the objective on all its samples and the outcome.
 
         Exactly ``options.starts`` local fits explore: the model's values, the previous
-        channel's optimum (when there is one and ``starts >= 2``), then Sobol points."""
+        channel's optimum (when there is one and ``starts >= 2``), the data's peak widths (a
+        model with several lobes, :meth:`data_starts`), then Sobol points."""
         full, explore = self.objectives(data)
         n = self.options.starts
         starts, origins = [self.start], ["model"]
         if self.warm is not None and n >= 2:
             starts.append(self.warm)
             origins.append("previous channel")
+        # several lobes: a narrow one at the data's peak width and one at its haze, in place
+        # of Sobol points (none for other models: their starts are as before)
+        peaks = self.data_starts(data, n - len(starts) - MIN_SOBOL)
+        starts += peaks
+        origins += ["data"] * len(peaks)
         sobol = screen(explore, self.candidates, n - len(starts))
         starts += sobol
         origins += ["sobol"] * len(sobol)
         outcome = search(full, explore, starts, self.options, self.on_start, origins)
         self.warm = outcome.theta.copy()
         return full, outcome
+
+    def data_starts(self, data: ChannelData, k: int) -> list[np.ndarray]:
+        """Up to ``k`` starts read off the channel's peaks for a model with several lobes
+        (:func:`~roughbrdf.fitting.problem.lobe_starts.lobe_starts`); none for other models
+        or data (Mueller elements: their first channel only is a BRDF)."""
+        from ..problem.data import ChannelData
+
+        if k <= 0 or not isinstance(data, ChannelData) or data.values.ndim != 1:
+            return []
+        return lobe_starts(self.spec, data, min(k, MAX_DATA_STARTS))
 
 
 @contextmanager

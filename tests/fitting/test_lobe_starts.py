@@ -91,6 +91,23 @@ def test_starts_do_not_hang_on_the_last_bits():
     assert len(a) == 2 and all(np.array_equal(p, q) for p, q in zip(a, b, strict=True))
 
 
+def test_three_lobes_start_a_wider_haze_with_the_same_share():
+    g = minidiff_grid()
+    truth = {"n": 1.5, "rho": 0.05, "alpha": 0.02, "alpha2": 0.15, "w2": 0.1}
+    x = rb.model("coated", lobes=2, distribution="beckmann", **truth).brdf(*g)
+    three = rb.model("coated", lobes=3, distribution="beckmann")
+    names = ["alpha", "alpha2", "w2", "alpha3", "w3"]
+    spec = ObjectiveSpec(three, names, [0.005, 0.005, 0.0, 0.005, 0.0],
+                         [1.5, 1.5, 1.0, 1.5, 1.0])
+    first, second = lobe_starts(spec, ChannelData.from_arrays(*g, x))
+    a, a2, w2, a3, w3 = first.tolist()
+    assert a == pytest.approx(truth["alpha"], rel=0.1)
+    assert second[0] == pytest.approx(a / 2, rel=0.01)
+    assert a2 == pytest.approx(truth["alpha2"], rel=0.1)
+    assert w2 == pytest.approx(truth["w2"], rel=0.15)
+    assert a3 == pytest.approx(4 * a2, rel=0.01) and w3 == w2
+
+
 @pytest.fixture(scope="module")
 def synthetic_fit():
     """The Beckmann pair fitted to one noisy set (rb.fit defaults)."""

@@ -207,7 +207,7 @@ def _haze(t: np.ndarray, e: np.ndarray, start: float, floor: float, dist: str
     nxt = next(((tt, ee) for tt, ee in rings[top + 1:] if ee < 0.5 * e1), None)
     if nxt is None:
         return math.nan, math.nan
-    t2, e2 = nxt[0], max(nxt[1], 1e-3 * e1)  # a median at or below 0: a tenth of a per mille
+    t2, e2 = nxt[0], max(nxt[1], 1e-3 * e1)  # a median at or below 0: a per mille of e1
     if dist == "beckmann":  # e = H exp(-t^2/a^2)
         a2 = (t2 * t2 - t1 * t1) / math.log(e1 / e2)
         height = e1 * math.exp(t1 * t1 / a2)
@@ -246,6 +246,7 @@ def peak_shape(t: np.ndarray, x: np.ndarray, dist: str, tilt: np.ndarray | None 
         return None
     floor = float(np.percentile(x[far], 25))
     top = float(np.max(x[near]))
+    # a floor below 0 (noise around a black sample's 0) counts as 0
     if not top > MIN_CONTRAST * max(floor, 0.0) or not top > 0.0:
         return None
     order = np.argsort(t, kind="stable")
@@ -304,6 +305,7 @@ def estimate_lobes(theta_i: Any, theta_r: Any, phi: Any, values: Any, dist: str,
         return LobeEstimate(round_sig(narrow), round_sig(5.0 * narrow), 0.05)
     wide = float(np.median([s.haze_slope / c for s in hazy]))
     # lobe heights w_j D_j(0) with D(0) = 1/(pi alpha^2): the haze's share of the weight
+    # a haze read as high as the whole peak leaves the narrow lobe nothing: its share -> 1
     ratios = [(s.haze_level / max(s.peak - s.haze_level, 1e-300)) * (s.haze_slope / s.half_slope)
               ** 2 for s in hazy]
     r = float(np.median(ratios))

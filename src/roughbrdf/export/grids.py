@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["INTEGRAL_RTOL", "REFINE_TARGET", "MAX_LEVEL", "MAX_TABLE_VALUES",
+__all__ = ["INTEGRAL_RTOL", "REFINE_TARGET", "grid_note", "MAX_LEVEL", "MAX_TABLE_VALUES",
            "TableAccuracyWarning", "Refined", "lobe_widths", "graded_axis", "cell_rule",
            "relative_errors", "refine"]
 
@@ -87,6 +87,25 @@ class Refined:
     level: int | None
     warning: str | None = None
     extra: Any = None
+
+
+def grid_note(level: int | None, layout: str) -> str:
+    """The header comment of an exported table saying how its grid was chosen: ``layout``
+    describes the grid (e.g. ``"dense around each AOI's specular direction"``); ``level`` is
+    the refinement level (None: the user's grid, as given).
+
+    Examples
+    --------
+    >>> grid_note(None, "graded")
+    'grid: as given'
+    >>> grid_note(2, "graded").split(",")[0]
+    'grid: graded'
+    """
+    if level is None:
+        return "grid: as given"
+    return (f"grid: {layout}, refinement level {level}, chosen so that the table's own "
+            f"integral is within {100 * REFINE_TARGET:g} % of TIS (promised: "
+            f"{100 * INTEGRAL_RTOL:g} %)")
 
 
 def relative_errors(integral: Any, tis: Any) -> np.ndarray:

@@ -57,10 +57,9 @@ from ..io.lighttools_write import (
 )
 from ..output import atomic_write, refuse_existing
 from .grids import (
-    INTEGRAL_RTOL,
-    REFINE_TARGET,
     cell_rule,
     graded_axis,
+    grid_note,
     lobe_widths,
     refine,
 )
@@ -339,19 +338,11 @@ def to_lighttools(model: Any, out: str | os.PathLike, *, angles_of_incidence: An
                 "angle from the normal; ScatterAzimuth about the normal, source at 90 deg, "
                 "specular at 270 deg", f"TIS = {how}; the table's own integral (trapezoid "
                 f"rule on this file's nodes) is within {100 * float(np.max(chosen.errors)):.2g}"
-                " % of it at every AOI", _grid_note(chosen.level), *notes]
+                " % of it at every AOI",
+                grid_note(chosen.level, "dense around each AOI's specular direction"), *notes]
     if chosen.warning is not None:
         comments.append("warning: " + chosen.warning)
     text = format_table(grid, {"value": values}, {"value": tis},
                         wavelengths={"value": wl}, comments=comments)
     atomic_write(path, text, overwrite=overwrite)
     return LightToolsFile(path, repr(model), grid, {"value": tis}, {"value": integral})
-
-
-def _grid_note(level: int | None) -> str:
-    """The header comment saying how the grid was chosen."""
-    if level is None:
-        return "grid: as given"
-    return (f"grid: dense around each AOI's specular direction, refinement level {level}, "
-            f"chosen so that the table's own integral is within {100 * REFINE_TARGET:g} % of "
-            f"TIS (promised: {100 * INTEGRAL_RTOL:g} %)")

@@ -58,10 +58,9 @@ from ..io.zemax import (
 from ..models.base import Model
 from ..output import OverwriteRefused
 from .grids import (
-    INTEGRAL_RTOL,
-    REFINE_TARGET,
     Refined,
     cell_rule,
+    grid_note,
     lobe_widths,
     refine,
     relative_errors,
@@ -463,18 +462,10 @@ def _write_one(model: Model, label: str | None, chosen: tuple[Refined, np.ndarra
         "TIS = the model's directional-hemispherical reflectance (roughbrdf.albedo); the "
         "table's own integral (trapezoid rule on this file's nodes) is within "
         f"{100 * float(np.max(table.errors)):.2g} % of it at every AngleOfIncidence",
-        _grid_note(table.level), "directions below the horizon hold 0", *notes]
+        grid_note(table.level, "graded from the specular direction"),
+        "directions below the horizon hold 0", *notes]
     if table.warning is not None:
         comments.append("warning: " + table.warning)
     tis_all = np.broadcast_to(tis, grid.shape[:2])
     write_table(path, grid, values, tis_all, comments=comments, overwrite=overwrite)
     return ZemaxFile(Path(path), label, repr(model), grid, tis, integral, **table.extra)
-
-
-def _grid_note(level: int | None) -> str:
-    """The header comment saying how the grid was chosen."""
-    if level is None:
-        return "grid: as given"
-    return (f"grid: graded from the specular direction, refinement level {level}, chosen so "
-            f"that the table's own integral is within {100 * REFINE_TARGET:g} % of TIS "
-            f"(promised: {100 * INTEGRAL_RTOL:g} %)")

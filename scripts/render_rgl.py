@@ -41,8 +41,8 @@ defaults)::
         [--paint C8_Silver] [--channel 525nm] [--size 96] [--spp 512] \\
         [--out docs/img/rgl_render.png]
 
-``tests/export/test_export_rgl_render.py`` runs :func:`compare` small (a synthetic coated
-model, 32 x 32) in CI.
+``tests/export/test_export_rgl_render.py`` runs :func:`compare` small (32 x 32, 16 spp) in
+CI, on a synthetic coated model and on this fit of C8_Silver.
 """
 
 from __future__ import annotations

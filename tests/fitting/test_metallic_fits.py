@@ -84,3 +84,25 @@ def test_coated_fit_of_bright_flakes_points_to_the_metallic_model():
     assert not m.at_bound and "HINT" not in right.report()
     for nm in ("r_m", "alpha_m", "d"):
         assert m.params[nm] == pytest.approx(BARE_FLAKES.params[nm], rel=1e-3), nm
+
+
+def test_auto_does_not_finish_a_candidate_stopped_on_a_search_limit():
+    # two channels of bare flakes (instrument noise): the same flakes under a coat want no
+    # coat, and the coat's n ends on its lower search limit 1.3 on the first channel (n = 1
+    # is no coat), which a whole fit keeps, so it would rank after the bare model whatever its
+    # score (compare.rank): auto fits it no further and says why (fitting/choice/auto.py)
+    one, two = _noisy(BARE_FLAKES, 1), _noisy(BARE_FLAKES, 2)
+    meas = rb.Measurement(one.theta_i, one.theta_r, one.phi,
+                          np.column_stack([one.values[:, 0], two.values[:, 0]]),
+                          channels=["a", "b"])
+    bare = "coated-conductor(coat=false, diffuse=true, flakes=reflectance)"
+    coat = "coated-conductor(diffuse=true, flakes=reflectance)"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", rb.fitting.EnergyWarning)
+        res = rb.fitting.fit_auto(meas, [coat, bare], progress=False)
+    rows = {c.label: c for c in res.model_choice.candidates}
+    assert res.model_choice.best.label == rb.models.spec_text(rb.models.from_spec(bare))
+    coated = rows[rb.models.spec_text(rb.models.from_spec(coat))]
+    assert coated.partial is not None and "on a search limit" in coated.partial, coated.partial
+    assert [c.channel for c in coated.result.channels] == ["a"]
+    assert [c.channel for c in res.channels] == ["a", "b"] and not res.at_search_limit

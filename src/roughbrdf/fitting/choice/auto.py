@@ -10,13 +10,15 @@ choice"):
 1. every candidate is fitted to the first channel, with that channel's held-out residuals;
 2. a candidate whose first-channel score is more than :data:`SKIP_MARGIN` above the best
    first-channel score (of the candidates whose fit neither gains energy nor has a parameter
-   on a search limit) is not fitted
-   further: its row keeps the first channel's figures and says so
-   (:attr:`~roughbrdf.fitting.choice.compare.Candidate.partial`), and it ranks after every whole
-   candidate. The others are fitted to the remaining channels, the search going on from the
-   first channel as in one whole fit (the same subsample draws, the first channel's optimum as
-   the warm start: the fit is the one ``compare`` makes), and scored over all channels as
-   ``compare`` scores them, the first channel's folds not refitted.
+   on a search limit) is not fitted further: its row keeps the first channel's figures and
+   says so (:attr:`~roughbrdf.fitting.choice.compare.Candidate.partial`), and it ranks after
+   every whole candidate. So is a candidate with a parameter on a search limit on the first
+   channel (while another has none): the whole fit would have it too and rank after every
+   candidate without one, whatever its score. The others are fitted to the remaining
+   channels, the search going on from the first channel as in one whole fit (the same
+   subsample draws, the first
+   channel's optimum as the warm start: the fit is the one ``compare`` makes), and scored over
+   all channels as ``compare`` scores them, the first channel's folds not refitted.
 
 Why: model choice cost 12x one ``coated`` fit, and a candidate that predicts the first channel
 3x worse than the best (TR75 on the shared paints) never won on the whole file. The margin is
@@ -127,11 +129,20 @@ def _in_two_stages(measurement: Measurement, models: list[Model], options: FitOp
     rows: list[Candidate] = []
     for m, first_row, held, score in zip(models, first_rows, helds, scores, strict=True):
         label, res = first_row.label, first_row.result
+        channel = res.channels[0].channel
         if not score <= best * (1 + SKIP_MARGIN):  # NaN: skipped too
-            channel = res.channels[0].channel
             rows.append(dataclasses.replace(first_row, partial=(
                 f"fitted to channel {channel} only: its score there ({score:.4g}) is more "
                 f"than {SKIP_MARGIN:.0%} above the best's ({best:.4g})")))
+            continue
+        if sound and res.at_search_limit:
+            # a search limit on the first channel stays one of the whole fit: it would rank
+            # after every candidate without one (compare.rank), whatever its score
+            names = ", ".join(sorted(nm for c in res.channels for nm, k in c.limits.items()
+                                     if k.startswith("search")))
+            rows.append(dataclasses.replace(first_row, partial=(
+                f"fitted to channel {channel} only: {names} on a search limit there; it "
+                f"would rank after the candidates without one")))
             continue
         # the other channels, the search going on from the first as in one whole fit: the
         # same fit as compare's, and the first channel's folds are not refitted

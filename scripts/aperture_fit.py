@@ -29,13 +29,15 @@ It prints Markdown tables (and writes them to ``--out FILE``). Run from the repo
     python scripts/aperture_fit.py              # both parts, about 16 min on 2 loaded cores
     python scripts/aperture_fit.py --part paints --paint C8_Silver \
         --model "coated-conductor(coat=false, diffuse=true, flakes=reflectance)"
-    python scripts/aperture_fit.py --quick      # 3 grid points, one paint, starts = 2 (~3 min)
+    python scripts/aperture_fit.py --part synthetic --seeds 3   # 723 s
+    python scripts/aperture_fit.py --quick      # 3 grid points, one paint, starts = 2 (not timed)
 
 Every fit uses ``starts = 4`` on the synthetic sets (one lobe, known box) and the default
 search on the paints; a run of the whole script took 939 s on two cores loaded by other work
 (2026-12-06; each aperture fit costs about 19 times the model evaluations of a plain one).
 ``--model`` changes the paints' model (its roughness column is the first of ``alpha``,
-``alpha_m`` it has), ``--paint`` the paints.
+``alpha_m`` it has), ``--paint`` the paints, ``--seeds`` the noise draws per synthetic set
+(one table row each).
 """
 
 from __future__ import annotations

@@ -4,7 +4,9 @@
 * ``paints``: the three Mini-Diff paints of :data:`MINIDIFF_PAINTS`, read once per test module.
 
 Hypothesis's profile is loaded here, before any test module is imported
-(tests/hypothesis_profiles.py): derandomized when ``CI`` is set, random otherwise.
+(tests/hypothesis_profiles.py): derandomized when ``CI`` is set, random otherwise; with
+``NUMBA_DISABLE_JIT=1`` (``make test-nojit``) derandomized and capped at a few examples per
+test, a test's own ``max_examples`` included (:func:`pytest_collection_modifyitems`).
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ from pathlib import Path
 import hypothesis_profiles
 import matplotlib
 import pytest
+from hypothesis import settings
 
 import roughbrdf as rb
 
@@ -43,6 +46,20 @@ def paints(shared_data: Path) -> dict[str, rb.Measurement]:
     """``{name: Measurement}`` of the :data:`MINIDIFF_PAINTS`, read once per test module (a
     module's tests may keep what they read); skips without ../shared/data."""
     return {name: rb.read(shared_data / "minidiff" / f"{name}.astm") for name in MINIDIFF_PAINTS}
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Under the ``"nojit"`` profile every Hypothesis test draws at most
+    :data:`hypothesis_profiles.NOJIT_MAX_EXAMPLES` examples, its own ``@settings`` included
+    (the kernels run as plain Python there; tests/hypothesis_profiles.py). Other profiles
+    leave every test's own count as it is."""
+    if HYPOTHESIS_PROFILE != "nojit":
+        return
+    cap = settings.get_profile("nojit").max_examples
+    for item in items:
+        fn = getattr(item, "function", None)  # a doctest or a non-Python item has none
+        if fn is not None:
+            hypothesis_profiles.capped(fn, cap)
 
 
 _LAST_TEST: list[str] = ["(none: inherited from the process that started pytest)"]

@@ -26,6 +26,13 @@ DRAWS_FILE = "ROUGHBRDF_TEST_DRAWS_FILE"
     ({"HYPOTHESIS_PROFILE": "ci"}, "ci"),
     ({"HYPOTHESIS_PROFILE": "dev", "CI": "true"}, "dev"),
     ({"HYPOTHESIS_PROFILE": "", "CI": "true"}, "ci"),
+    ({"NUMBA_DISABLE_JIT": "1"}, "nojit"),
+    ({"NUMBA_DISABLE_JIT": "1", "CI": "true"}, "nojit"),
+    ({"NUMBA_DISABLE_JIT": " 2 "}, "nojit"),
+    ({"NUMBA_DISABLE_JIT": "0", "CI": "true"}, "ci"),
+    ({"NUMBA_DISABLE_JIT": ""}, "dev"),
+    ({"NUMBA_DISABLE_JIT": "yes"}, "dev"),  # not an integer: Numba ignores it, the JIT runs
+    ({"NUMBA_DISABLE_JIT": "1", "HYPOTHESIS_PROFILE": "dev"}, "dev"),
 ])
 def test_the_environment_selects_the_profile(environ, expected):
     assert hypothesis_profiles.select(environ) == expected
@@ -40,6 +47,32 @@ def test_the_ci_profile_is_derandomized_and_the_dev_profile_is_not():
     ci, dev = settings.get_profile("ci"), settings.get_profile("dev")
     assert ci.derandomize and ci.database is None and ci.deadline is None and ci.print_blob
     assert not dev.derandomize and dev.print_blob and dev.database is not None
+
+
+def test_the_nojit_profile_is_the_ci_profile_with_few_examples():
+    ci, nojit = settings.get_profile("ci"), settings.get_profile("nojit")
+    assert nojit.derandomize and nojit.database is None and nojit.deadline is None
+    assert nojit.max_examples == hypothesis_profiles.NOJIT_MAX_EXAMPLES < ci.max_examples
+    assert nojit.suppress_health_check == ci.suppress_health_check
+
+
+def test_capped_lowers_a_tests_own_count_and_keeps_its_other_settings():
+    @settings(max_examples=40, deadline=1000, derandomize=True)
+    @given(st.integers())
+    def many(x):
+        pass
+
+    @settings(max_examples=2)
+    @given(st.integers())
+    def few(x):
+        pass
+
+    assert hypothesis_profiles.capped(many, 3) and hypothesis_profiles.capped(few, 3)
+    own = many._hypothesis_internal_use_settings
+    assert own.max_examples == 3 and own.derandomize
+    assert own.deadline is not None and own.deadline.total_seconds() == 1
+    assert few._hypothesis_internal_use_settings.max_examples == 2  # never raised
+    assert not hypothesis_profiles.capped(lambda: None, 3)  # not a Hypothesis test
 
 
 def test_this_run_loaded_the_profile_its_environment_selects():
@@ -61,9 +94,10 @@ def test_draws_recorded(x):
 
 def _draws(tmp_path: Path, run: int, **env: str) -> list[str]:
     """The draws of :func:`test_draws_recorded` in a fresh pytest process with ``env`` added to
-    an environment without ``CI`` and ``HYPOTHESIS_PROFILE``."""
+    an environment without ``CI``, ``HYPOTHESIS_PROFILE`` and ``NUMBA_DISABLE_JIT``."""
     out = tmp_path / f"draws{run}.txt"
-    base = {k: v for k, v in os.environ.items() if k not in ("CI", "HYPOTHESIS_PROFILE")}
+    base = {k: v for k, v in os.environ.items()
+            if k not in ("CI", "HYPOTHESIS_PROFILE", "NUMBA_DISABLE_JIT")}
     proc = subprocess.run(
         [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "no:randomly",
          f"{HERE}::test_draws_recorded"],
@@ -80,3 +114,13 @@ def test_ci_draws_the_same_examples_on_every_run_and_dev_does_not(tmp_path):
     # 5 draws of an integer each from a random seed: two runs agree by chance with a
     # probability far below 1e-12
     assert len(dev[0]) == 5 and dev[0] != dev[1]
+
+
+def test_a_nojit_run_draws_the_same_few_examples_whatever_the_test_asks(tmp_path):
+    # test_draws_recorded asks for 5 examples; a run with NUMBA_DISABLE_JIT=1 (or the profile
+    # named) draws NOJIT_MAX_EXAMPLES, the same ones every time: the cap of tests/conftest.py
+    # reaches a test's own @settings (a Hypothesis release that reads the settings elsewhere
+    # fails here)
+    runs = [_draws(tmp_path, 0, NUMBA_DISABLE_JIT="1"),
+            _draws(tmp_path, 1, HYPOTHESIS_PROFILE="nojit")]
+    assert len(runs[0]) == hypothesis_profiles.NOJIT_MAX_EXAMPLES and runs[0] == runs[1]

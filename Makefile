@@ -5,7 +5,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed-$(shell cat pyproject.toml | cksum | cut -d' ' -f1)
 
-.PHONY: demo test test-avx2 bench lint clean venv browser
+.PHONY: demo test test-avx2 test-nojit bench lint clean venv browser
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -68,6 +68,15 @@ test-avx2: $(STAMP)
 	  echo "test-avx2: this processor has no AVX-512: 'make test' ran these tests with its own" \
 	       "AVX2 (or narrower) kernels; not repeated"; \
 	fi
+
+# The suite with Numba's JIT off: every kernel runs as plain Python (the debugging and coverage
+# mode the project keeps working). Hypothesis draws a few derandomized examples per test there
+# (the "nojit" profile, tests/hypothesis_profiles.py) and the tests marked jit_heavy (whole fits
+# of the measured paints, big catalogues, browser tests that fit: each mark gives its reason)
+# are deselected; a test over 5 min fails (mark it, with its reason). One process: slow (tens
+# of minutes), not part of `make test`.
+test-nojit: $(STAMP)
+	NUMBA_DISABLE_JIT=1 $(PY) -m pytest -q -p no:cacheprovider -m "not jit_heavy" --timeout=300 --durations=15
 
 # BENCH_ARGS: e.g. --skip-worker-memory (the slow worker-memory figure), or benchmark names
 bench: $(STAMP)

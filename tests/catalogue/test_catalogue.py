@@ -24,6 +24,10 @@ from roughbrdf.catalogue.resume import TASK_FILE
 from roughbrdf.cli import app
 from roughbrdf.output import LOCK, MANIFEST, TMP_PREFIX
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="catalogues: every row is a whole fit (~40 s or more in plain Python)")
+
 pytest.importorskip("distributed")
 
 runner = CliRunner()

@@ -21,6 +21,10 @@ from roughbrdf.catalogue import fit_catalogue, run
 from roughbrdf.cli import main
 from roughbrdf.errors import ArgumentError
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="catalogues: every row is a whole fit (~40 s or more in plain Python)")
+
 pytest.importorskip("distributed")
 
 

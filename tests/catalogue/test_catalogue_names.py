@@ -15,6 +15,10 @@ import roughbrdf as rb
 from roughbrdf.catalogue import fit_catalogue, folder_names
 from roughbrdf.cli import main
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="catalogues: every row is a whole fit (~40 s or more in plain Python)")
+
 pytest.importorskip("distributed")
 
 #: inputs whose stems are dot-only, collide with each other or with the generated -N names,

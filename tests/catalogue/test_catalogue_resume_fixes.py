@@ -34,6 +34,10 @@ from roughbrdf.catalogue.summary import md_text, write_summary
 from roughbrdf.cli import app
 from roughbrdf.output import LOCK, TMP_PREFIX
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="catalogues: every row is a whole fit (~40 s or more in plain Python)")
+
 runner = CliRunner()
 #: the fastest fit: one start, no plots, the constraint off (a Lambertian fit of Lambertian
 #: data is "ok"; TR75 without shadowing gains energy, "gains-energy", as in test_catalogue.py)

@@ -20,6 +20,10 @@ from typer.testing import CliRunner
 import roughbrdf as rb
 from roughbrdf.cli import app
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 runner = CliRunner()
 RHOS = {"b": 0.1, "g": 0.3, "r": 0.6}
 MODELS = "lambertian, coated"

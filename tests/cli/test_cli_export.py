@@ -22,6 +22,10 @@ import roughbrdf as rb
 from roughbrdf.cli import app
 from roughbrdf.export.mitsuba import to_mitsuba
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 runner = CliRunner()
 
 

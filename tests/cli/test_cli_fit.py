@@ -14,6 +14,10 @@ from roughbrdf.cli import app
 from roughbrdf.cli.fit import build_model, resolve_names
 from roughbrdf.demo import default_measurement_path
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 runner = CliRunner()
 DEFAULT = default_measurement_path()
 

@@ -24,6 +24,10 @@ from roughbrdf.cli import app, main
 from roughbrdf.demo import default_measurement_path
 from roughbrdf.output import JOURNAL, LOCK, MANIFEST, TMP_PREFIX, file_sha256, read_manifest
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 runner = CliRunner()
 DEFAULT = default_measurement_path()
 _SCRIPT = os.path.join(os.path.dirname(sys.executable), "roughbrdf")

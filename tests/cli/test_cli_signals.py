@@ -26,6 +26,10 @@ import pytest
 import roughbrdf as rb
 from roughbrdf.demo import default_measurement_path
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 SOURCE = str(default_measurement_path())
 #: a bound on one subprocess: only against a hung test
 HANG = 300

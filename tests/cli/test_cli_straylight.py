@@ -22,6 +22,10 @@ from roughbrdf.cli import app
 from roughbrdf.fitting.choice.compare import AUTO_CANDIDATES
 from roughbrdf.fitting.results.plausibility import EXPORT_INCIDENCES_DEG
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 DATA = Path(__file__).parents[1] / "data" / "zemax"
 ANOBLACK = DATA / "AnoBlackNiTEonINVAR.bsdf"
 AEROGLAZE = DATA / "aeroglaze.bsdf"

@@ -16,6 +16,10 @@ import roughbrdf as rb
 from roughbrdf.cli import main
 from roughbrdf.measurement import Measurement
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 THETA_R = "0:80:20"
 PHI = "0:180:90"
 

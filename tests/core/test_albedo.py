@@ -53,6 +53,7 @@ def _brute(model, theta_i):
     return float(2 * np.sum(f * np.sin(tr)[:, None] * wt[:, None] * wp[None, :]))
 
 
+@pytest.mark.jit_heavy(reason="default albedo grid vs a brute-force one: minutes in plain Python")
 @pytest.mark.parametrize("name, kw, theta_i", [
     ("trowbridge-reitz-1975", {"e": 0.68, "n": 1.0, "k": 0.9, "rho_L": 0.33}, math.radians(45)),
     ("torrance-sparrow-1967", {"g": 2.0, "c": 0.02, "n": 1.5, "rho_d": 0.3}, math.radians(30)),
@@ -115,6 +116,7 @@ def test_polarization():
     assert s > p  # R_s > R_p for a dielectric
 
 
+@pytest.mark.jit_heavy(reason="albedos on the default grid: minutes in plain Python")
 def test_energy_conservation_with_smith():
     # F = 1 with Smith height-correlated masking-shadowing: albedo <= 1 (single scattering
     # loses energy, it never creates it); near 1 for a smooth surface at normal incidence

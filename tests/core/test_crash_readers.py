@@ -46,6 +46,10 @@ from roughbrdf.explore.app_state import load_session
 from roughbrdf.output import JOURNAL, LOCK, MANIFEST
 from roughbrdf.result_check import ResultFolderRefused
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 #: run in a subprocess: ``python -c HOOK FOLDER k ARGS...`` runs ``roughbrdf ARGS`` and kills
 #: itself at the k-th os.replace or os.unlink of a path inside FOLDER (0: never), then prints
 #: how many it saw

@@ -22,6 +22,7 @@ def test_embedded_default_measurement_is_tr75_design():
     assert len(meas.incidences(3)) == 6
 
 
+@pytest.mark.jit_heavy(reason="the demo fits the cement data: minutes in plain Python")
 def test_demo_prints_tables_and_recovers_cement(tmp_path, capsys):
     assert demo.main(["--out", str(tmp_path / "out")]) == 0
     text = capsys.readouterr().out
@@ -40,6 +41,7 @@ def test_demo_prints_tables_and_recovers_cement(tmp_path, capsys):
     assert demo.main(["--out", str(out), "--force"]) == 0
 
 
+@pytest.mark.jit_heavy(reason="the demo's tables (TR75 albedos): minutes in plain Python")
 def test_demo_tables_match_models_md():
     t = demo.ts67_fig8_table()
     for psi, ref in demo.TS67_FIG8.items():

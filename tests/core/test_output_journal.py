@@ -22,6 +22,10 @@ from roughbrdf.cli import main
 from roughbrdf.demo import default_measurement_path
 from roughbrdf.output import JOURNAL, LOCK, MANIFEST, TMP_PREFIX, ResultFolder, recover
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 #: run in a subprocess: ``python -c HOOK k`` kills itself at the k-th os.replace (0: never)
 #: and prints the number of calls it saw; then runs the code given on stdin
 HOOK = r"""

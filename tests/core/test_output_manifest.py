@@ -15,6 +15,10 @@ from roughbrdf.cli import main
 from roughbrdf.demo import default_measurement_path
 from roughbrdf.output import MANIFEST, ManifestRefused, OverwriteRefused, ResultFolder
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 FIT = ["fit", str(default_measurement_path()), "-m", "lambertian"]
 
 

@@ -24,6 +24,10 @@ from roughbrdf import plot
 from roughbrdf.cli import main
 from roughbrdf.measurement import Measurement
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 ROUGH = dict(e=0.4, n=1.5, k=0.0, rho_L=0.1)
 SHARP = dict(e=0.05, n=1.5, k=0.0, rho_L=0.1)
 

@@ -37,6 +37,10 @@ from roughbrdf.explore.app_state import load_session  # noqa: E402
 from roughbrdf.explore.figures import figure_values  # noqa: E402
 from roughbrdf.explore.server import bind  # noqa: E402
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="browser tests that fit: ~40 s per fit in plain Python")
+
 DATA = Path(__file__).parents[1] / "data"
 ZEMAX = DATA / "zemax" / "AnoBlackNiTEonINVAR.bsdf"
 #: seconds the page may take to reach a state before the test counts it as hung (a first

@@ -38,6 +38,10 @@ from roughbrdf.export.mitsuba import (
     to_mitsuba_xml,
 )
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="each export checks the albedo at 19 incidences: ~1 min in plain Python")
+
 # ImportError too: an installed package whose native library cannot load on this platform
 mi = pytest.importorskip("mitsuba", reason="the mitsuba package (test extra) is not installed "
                          "or cannot be imported on this platform", exc_type=ImportError)

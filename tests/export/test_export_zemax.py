@@ -16,6 +16,10 @@ from roughbrdf.export.zemax import default_grid, lobe_width, to_zemax
 from roughbrdf.io.zemax import read_table, table_integral
 from roughbrdf.output import OverwriteRefused
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="each export checks the albedo at 19 incidences: ~1 min in plain Python")
+
 MODELS = {
     "lambertian": lambda: rb.model("lambertian", rho=0.5),
     "coated": lambda: rb.model("coated"),

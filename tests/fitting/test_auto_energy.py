@@ -27,6 +27,11 @@ import pytest
 import roughbrdf as rb
 from roughbrdf.fitting.results.plausibility import EXPORT_INCIDENCES_DEG
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="whole fits of the measured paints: many minutes each in plain Python")
+
+
 _FITS: dict[str, rb.fitting.FitResult] = {}
 
 

@@ -19,6 +19,10 @@ import roughbrdf.fitting.choice.auto  # noqa: F401  (the module, not the functio
 from roughbrdf.fitting.kinds.channels import fit_model
 from roughbrdf.fitting.problem.options import FitOptions
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 auto = sys.modules["roughbrdf.fitting.choice.auto"]
 
 TRUTH = rb.model("coated", n=1.5, rho=0.3, alpha=0.15)

@@ -17,6 +17,10 @@ import roughbrdf as rb
 from roughbrdf.fitting.solvers import search
 from roughbrdf.fitting.solvers.bounded import LAMBDA_MAX, BoundedResult, bounded_lm, bounded_step
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="whole fits of the measured paints: many minutes each in plain Python")
+
 
 class Residuals:
     """A duck-typed objective (``fun``, ``jac``, ``spec.lower/upper``) that counts calls."""

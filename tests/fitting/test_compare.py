@@ -35,6 +35,10 @@ from roughbrdf.fitting.choice.compare import (
 from roughbrdf.models import from_spec, spec_text
 from roughbrdf.models.factory import split_specs
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 TRUTH = rb.model("coated", n=1.5, rho=0.3, alpha=0.15)
 STARTS = 2
 

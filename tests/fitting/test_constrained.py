@@ -23,6 +23,10 @@ from roughbrdf.fitting.results.plausibility import (
 from roughbrdf.fitting.solvers.bounded import GaussNewtonModel
 from roughbrdf.fitting.solvers.constrained import Limits, constrained_lm, finite_limits, lsi_step
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 THETA = np.radians(EXPORT_INCIDENCES_DEG)
 #: the convergence test of tol = 1e-12 bounds the predicted cost decrease by tol * cost: the
 #: end point is within about sqrt(tol) (residual units, here those of the parameters) of the

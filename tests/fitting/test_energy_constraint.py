@@ -26,6 +26,10 @@ from roughbrdf.fitting.results.plausibility import (
 )
 from roughbrdf.models import model_label
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="whole fits of the measured paints: many minutes each in plain Python")
+
 GRID = np.radians(np.mgrid[0:61:20, 0:81:5, 0:181:30].reshape(3, -1))
 THETA = np.radians(EXPORT_INCIDENCES_DEG)
 #: RB08 with its Fresnel factor off (n_eff = 1): the bulk and retro terms reflect 1.38 at 89 deg

@@ -23,6 +23,10 @@ import pytest
 import roughbrdf as rb
 from roughbrdf.fitting.results.statistics import Covariance
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 TRUTH = rb.model("coated", lobes=2, n=1.5, rho=0.3, alpha=0.08, alpha2=0.3, w2=0.3)
 SEEDS = range(20)
 

@@ -17,6 +17,10 @@ from roughbrdf.errors import ArgumentError
 from roughbrdf.fitting.problem.data import outside_fit_domain
 from roughbrdf.measurement import Measurement
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 MODEL = rb.model("trowbridge-reitz-1975", e=0.4, rho_L=0.05)
 T_MAX, EXCL = math.radians(70.0), math.radians(12.0)
 

@@ -18,6 +18,10 @@ from roughbrdf.errors import ArgumentError
 from roughbrdf.fitting.results.plausibility import ALBEDO_INCIDENCES_DEG, EnergyWarning
 from roughbrdf.journal import MANIFEST
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 GRID = np.radians(np.mgrid[0:61:30, 0:81:10, 0:181:45].reshape(3, -1))
 # ks inside its search range [0, 1]: a fit that ends on its bound 1 is on a search limit
 TRUTH = rb.model("microfacet", alpha=0.3, n=1.5, ks=0.8)

@@ -13,6 +13,10 @@ import pytest
 import roughbrdf as rb
 from roughbrdf.cli import main
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 #: a coarse in-plane and out-of-plane grid (degrees -> radians)
 GRID = np.radians(np.mgrid[0:61:20, 0:81:5, 0:181:30].reshape(3, -1))
 

@@ -25,6 +25,10 @@ from roughbrdf.models import is_auto
 from roughbrdf.quantity import LOSSES as QUANTITY_LOSSES
 from roughbrdf.quantity import relative_scale
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 
 def _measurement(channels: int = 1) -> Measurement:
     g = np.radians(np.mgrid[10:61:25, 0:81:10, 0:181:45].reshape(3, -1))

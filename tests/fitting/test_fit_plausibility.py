@@ -10,6 +10,10 @@ import roughbrdf as rb
 from roughbrdf.cli import main
 from roughbrdf.measurement import Measurement
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 
 def _measurement(values: np.ndarray, channels: list[str]) -> Measurement:
     ti, tr = np.meshgrid(np.radians([10.0, 30.0, 50.0]), np.radians(np.arange(0.0, 80.0, 10.0)))

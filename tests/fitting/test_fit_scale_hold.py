@@ -13,6 +13,10 @@ import pytest
 
 import roughbrdf as rb
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 TRUTH = rb.model("microfacet", alpha=0.25, n=1.5, k=0.0, ks=0.6)
 
 

@@ -20,6 +20,10 @@ from roughbrdf.fitting.problem.wavelengths import (
     with_wavelength,
 )
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 TRUTH = {"A": 2e-5, "B": 8.0, "C": 3.0}
 
 

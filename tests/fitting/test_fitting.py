@@ -26,6 +26,10 @@ from roughbrdf.instrument import (
 )
 from roughbrdf.measurement import Measurement
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 
 def fit(*args, **kwargs) -> rb.FitResult:
     """``rb.fit`` without the energy constraint (module notes), unless a test sets it."""

@@ -22,6 +22,10 @@ from roughbrdf.fitting.solvers.threads import single_thread_blas
 from roughbrdf.measurement import Measurement
 from roughbrdf.quantity import relative_scale
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 
 @pytest.fixture(scope="module")
 def ts67_data():

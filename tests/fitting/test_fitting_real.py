@@ -20,6 +20,10 @@ import pytest
 
 import roughbrdf as rb
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="whole fits of the measured paints: many minutes each in plain Python")
+
 PAINTS = ("C2_Black", "C8_Silver", "C12_OliveDrab")
 
 MODELS = {

@@ -29,6 +29,10 @@ import roughbrdf as rb
 from roughbrdf.errors import ArgumentError
 from roughbrdf.fitting.choice.compare import information
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 SHARED_TRUE = {"n": 1.5, "alpha": 0.15}
 RHO_TRUE = {"b": 0.1, "g": 0.3, "r": 0.6}
 STARTS = 2

@@ -23,6 +23,10 @@ from roughbrdf.errors import ArgumentError
 from roughbrdf.fitting.load import InputChangedWarning
 from roughbrdf.journal import MANIFEST
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 DATA = Path(__file__).parents[1] / "data" / "zemax" / "AnoBlackNiTEonINVAR.bsdf"
 
 

@@ -17,6 +17,10 @@ from roughbrdf.errors import ArgumentError
 from roughbrdf.fitting import LOSSES, Loss
 from roughbrdf.quantity import ROBUST_SCALE, relative_scale
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 C = ROBUST_SCALE
 
 

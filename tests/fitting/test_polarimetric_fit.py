@@ -22,6 +22,10 @@ from roughbrdf.fitting.kinds.polarimetric import MuellerFitResult
 from roughbrdf.io import FormatError
 from roughbrdf.measurement import MUELLER_ELEMENTS, Measurement
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 TRUE = {"alpha": 0.3, "n": 0.2, "k": 3.0}
 SIGMA_M00 = 0.02  # relative noise of m00
 SIGMA_NORM = 0.01  # absolute noise of the normalized elements

@@ -25,6 +25,10 @@ from roughbrdf.fitting.results.report import MAX_PERCENT_RATIO, percent
 from roughbrdf.fitting.results.statistics import AT_BOUND_RTOL, at_bound
 from roughbrdf.measurement import Measurement
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's plausibility albedo alone takes ~40 s in plain Python")
+
 TS67_TRUE = {"g": 2.0, "c": 0.08, "rho_d": 0.3}
 
 

@@ -23,6 +23,10 @@ import pytest
 
 import roughbrdf as rb
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="whole fits of the measured paints: many minutes each in plain Python")
+
 #: the relative size of the perturbation: the rounding of another vector width
 PERTURB = 1e-13
 GRID = np.radians(np.mgrid[0:61:20, 0:81:5, 0:181:30].reshape(3, -1))

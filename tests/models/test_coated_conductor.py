@@ -72,6 +72,7 @@ def metallic_models(draw):
     return rb.model("metallic", **kw)
 
 
+@pytest.mark.jit_heavy(reason="albedos at 19 incidences per example: minutes each in plain Python")
 @settings(max_examples=40, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow])
 @given(metallic_models())
@@ -80,6 +81,7 @@ def test_hypothesis_albedo_at_most_one(m):
     assert a.max() <= 1.0 + TOL, f"{m!r} reflects {a.max():.5f}"
 
 
+@pytest.mark.jit_heavy(reason="albedos on the default grid: minutes in plain Python")
 def test_white_pigment_corner_conserves_energy():
     # the tightest corner: white pigment (albedo 1 inside), the coat lobe whose facet-averaged
     # F exceeds R(theta) (Beckmann alpha ~ 0.22, the coated model's worst corner), no loss

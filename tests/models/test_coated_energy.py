@@ -26,6 +26,10 @@ from hypothesis import strategies as st
 import roughbrdf as rb
 from roughbrdf.errors import ArgumentError
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="coated albedos at 19 incidences (~3 min each) and fits, in plain Python")
+
 #: the incidences of the fits' energy check (docs/models.md, "What each model guarantees")
 INCIDENCES = np.radians([*range(0, 90, 5), 89])
 TOL = 1e-3

@@ -32,6 +32,7 @@ import numpy as np
 import pytest
 
 import roughbrdf as rb
+from roughbrdf._kernels import DISABLE_JIT
 from roughbrdf.errors import ArgumentError
 from roughbrdf.fresnel import fresnel_amplitudes
 from roughbrdf.mueller import coherency, depolarizer, fresnel_mueller, jones_to_mueller
@@ -198,7 +199,10 @@ def test_depolarizer_and_coherency():
 # ------------------------------------------------------------------------------------------
 # invariants of every model with a Mueller matrix, on random geometries
 # ------------------------------------------------------------------------------------------
-TI, TR, PH = geometries(600, 2)
+#: geometries per invariant test; a tenth under NUMBA_DISABLE_JIT=1 (make test-nojit), where
+#: a three-lobe coated Mueller matrix takes minutes for 600 of them in plain Python
+N_GEOMETRIES = 60 if DISABLE_JIT else 600
+TI, TR, PH = geometries(N_GEOMETRIES, 2)
 GAMMA = np.random.default_rng(3).uniform(-math.pi, math.pi, TI.size)
 
 
@@ -246,7 +250,7 @@ def test_reciprocity_and_mirror_symmetry(spec):
     # -1). Every model here is reciprocal in its scalar BRDF
     m = build(spec)
     assert m.reciprocal
-    ti, tr, ph = geometries(300, 4, top=math.radians(80))
+    ti, tr, ph = geometries(N_GEOMETRIES // 2, 4, top=math.radians(80))
     a = m.mueller(ti, tr, ph)
     tol = 5e-13 * a[:, 0, 0][:, None, None]
     assert_within(m.mueller(tr, ti, -ph), Q @ np.swapaxes(a, -1, -2) @ Q, tol)

@@ -133,6 +133,7 @@ def fitted() -> rb.FitResult:
     return rb.fit("tr75", rb.read(DATA), starts=1, progress=False, loss="relative")
 
 
+@pytest.mark.jit_heavy(reason="a TR75 fit of a measured file: over 5 min in plain Python")
 def test_fit_html_holds_parameters_stderr_and_figures_of_merit(fitted):
     text = fitted._repr_html_()
     got = cells(text)
@@ -158,6 +159,7 @@ def test_fit_html_escapes_channel_labels():
     assert "0.3" in cells(text)  # rho fitted to the synthetic truth, 6 significant digits
 
 
+@pytest.mark.jit_heavy(reason="a TR75 fit of a measured file: over 5 min in plain Python")
 def test_loaded_fit_has_the_same_html(fitted, tmp_path):
     fitted.save(tmp_path, plots=False)
     assert rb.load_fit(tmp_path)._repr_html_() == fitted._repr_html_()
@@ -202,6 +204,7 @@ def test_mime_bundle_of_a_model_renders_offline():
     assert bundle["text/plain"] == "Explorer: model lambertian at theta_i = 30 deg\nno measurement"
 
 
+@pytest.mark.jit_heavy(reason="a TR75 fit of a measured file: over 5 min in plain Python")
 def test_explore_a_fit_draws_its_model_and_data(fitted):
     ex = rb.explore(fitted, resolution=11)
     assert ex.model is fitted[0].model and ex.measurement is fitted.measurement
@@ -232,6 +235,7 @@ def test_explore_a_measurement_alone():
     assert "714" in cells(bundle["text/html"])  # the measurement's table: its samples
 
 
+@pytest.mark.jit_heavy(reason="the explorer's albedo curve: over 5 min in plain Python")
 def test_explore_options_and_models_without_mueller():
     ts = rb.model("torrance-sparrow-1967", n=None, k=None)  # F = 1: no Mueller matrix
     assert len(rb.explore(ts, resolution=11).figures()) == 4

@@ -36,6 +36,7 @@ def test_a_model_is_one_row_with_its_values_and_tis(tmp_path):
     assert "not publicly documented" in text  # says what it is
 
 
+@pytest.mark.jit_heavy(reason="fits per incidence: minutes in plain Python")
 def test_per_incidence_rows_are_the_kept_fits(tmp_path):
     # 12 incidences of a synthetic ABg whose A falls with incidence: at most 10 rows kept
     angles = np.radians(np.linspace(0.0, 77.0, 12))

@@ -176,6 +176,7 @@ def _figure_divs(text: str) -> list[str]:
             and re.fullmatch(r"roughbrdf-explore-[0-9a-f]+-\d+", a["id"] or "")]
 
 
+@pytest.mark.jit_heavy(reason="the explorer's albedo curve: ~3 min in plain Python")
 def test_mime_bundle_of_a_model_renders_offline():
     m = rb.model("lambertian", rho=0.4)
     ex = rb.explore(m, resolution=11)

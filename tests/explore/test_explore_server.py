@@ -326,6 +326,7 @@ def test_a_typed_value_outside_the_domain_keeps_the_model_and_says_why() -> None
     assert bad == {} and model.params["sigma"] == pytest.approx(0.3490658503988659)
 
 
+@pytest.mark.jit_heavy(reason="exports check 19 albedos: 2 min in plain Python")
 def test_exports_land_only_in_the_out_folder(tmp_path: Path) -> None:
     out = tmp_path / "out"
     out.mkdir()

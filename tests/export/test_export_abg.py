@@ -18,6 +18,10 @@ from roughbrdf.export.abg_catalog import MAX_ROWS, write_abg_catalog
 from roughbrdf.fitting.kinds.per_incidence import fit_per_incidence
 from roughbrdf.output import OverwriteRefused
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="each export checks the albedo at 19 incidences: ~1 min in plain Python")
+
 
 def _rows(text):
     """The table's data rows as (angle, A, B, g, TIS)."""
@@ -36,7 +40,6 @@ def test_a_model_is_one_row_with_its_values_and_tis(tmp_path):
     assert "not publicly documented" in text  # says what it is
 
 
-@pytest.mark.jit_heavy(reason="fits per incidence: minutes in plain Python")
 def test_per_incidence_rows_are_the_kept_fits(tmp_path):
     # 12 incidences of a synthetic ABg whose A falls with incidence: at most 10 rows kept
     angles = np.radians(np.linspace(0.0, 77.0, 12))

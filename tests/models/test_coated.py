@@ -500,6 +500,7 @@ def test_lambertian_and_oren_nayar_substrates():
 INCIDENCES = np.radians([0.0, 15, 30, 45, 60, 70, 80, 85, 88, 89.5, 89.9])
 
 
+@pytest.mark.jit_heavy(reason="coated albedos on the default grid: over 5 min in plain Python")
 @pytest.mark.parametrize("n", [1.05, 1.5, 2.5])
 def test_energy_identity_of_the_substrate(n):
     # ks = 0, no diffuse shadowing: all light refracted into the coating comes back out when

@@ -30,6 +30,10 @@ from roughbrdf.export.rgl import to_rgl
 from roughbrdf.io.rgl_tensor import decode
 from roughbrdf.output import OverwriteRefused
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="RGL exports: power iterations and 19 albedos per export, minutes in plain Python")
+
 mi = pytest.importorskip("mitsuba", reason="the mitsuba package (test extra) is not installed "
                          "or cannot be imported on this platform", exc_type=ImportError)
 

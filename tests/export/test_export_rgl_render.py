@@ -29,6 +29,10 @@ import pytest
 
 import roughbrdf as rb
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="RGL exports and fits: minutes in plain Python")
+
 mi = pytest.importorskip("mitsuba", reason="the mitsuba package (test extra) is not installed "
                          "or cannot be imported on this platform", exc_type=ImportError)
 

@@ -29,6 +29,10 @@ from roughbrdf.export.lighttools import to_lighttools
 from roughbrdf.export.zemax import to_zemax
 from roughbrdf.io.zemax import read_table, table_integral
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="table exports refined to TIS and a fit: minutes in plain Python")
+
 runner = CliRunner()
 
 ABG = {"A": 0.02, "B": 0.001, "g": 1.8}

@@ -21,6 +21,10 @@ from roughbrdf.fitting import ChannelData, ObjectiveSpec
 from roughbrdf.fitting.problem.lobe_starts import estimate_lobes, lobe_starts
 from roughbrdf.fitting.solvers.search import MultiStart
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's energy check alone takes ~40 s in plain Python")
+
 #: a narrow Beckmann lobe with a haze 5 times wider holding 10 % of the weight, over a
 #: substrate that stands above the noise floor (1e-3 of the 60 deg peak)
 TRUTH = {"n": 1.5, "rho": 0.5, "alpha": 0.03, "alpha2": 0.15, "w2": 0.1}

@@ -23,6 +23,10 @@ import pytest
 
 import roughbrdf as rb
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="fits: each fit's energy check alone takes ~40 s in plain Python")
+
 COATED_METAL = rb.model("metallic", flakes="reflectance", diffuse=True, n=1.5, alpha=0.1,
                         r_m=0.8, g_m=None, alpha_m=0.2, d=0.1)
 BARE_FLAKES = rb.model("metallic", coat=False, flakes="reflectance", r_m=0.9, g_m=0.5,

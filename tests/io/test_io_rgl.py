@@ -19,6 +19,10 @@ from roughbrdf.io import FormatError, format_for
 from roughbrdf.io.rgl_tensor import decode, encode
 from roughbrdf.quantity import Quantity
 
+#: too slow without the JIT: make test-nojit deselects them (-m 'not jit_heavy')
+pytestmark = pytest.mark.jit_heavy(
+    reason="RGL exports (the reader's inputs): minutes in plain Python")
+
 SMALL = {"theta_i": 10, "samples": 24, "vndf": 32, "ndf": 128}
 COATED = rb.model("coated", alpha=0.2, n=1.5, rho=0.4)
 

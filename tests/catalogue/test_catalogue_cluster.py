@@ -191,7 +191,7 @@ def test_ctrl_c_during_start_is_one_line_and_stops_the_workers(data, tmp_path, d
                      "absolute, robust)"),
     (["--seed", "-1"], "error: --seed must be >= 0 (got -1)"),
     (["--format", "zz"], "error: --format: unknown value 'zz' (choose from astm, alta, merl, "
-                         "csv, zemax, lighttools)"),
+                         "csv, zemax, lighttools, rgl)"),
     (["--relative-to", "zz"], "error: --relative-to: unknown value 'zz' (choose from brdf, "
                               "bridf)"),
     (["--negative", "zz"], "error: --negative zz: must be 'auto', 'keep', 'drop' or 'clip'"),

@@ -57,7 +57,8 @@ def test_metallic_paint_intervals_cover_the_truth():
     for seed in seeds:
         with warnings.catch_warnings():
             warnings.simplefilter("error", rb.fitting.EnergyWarning)  # none may gain energy
-            res = rb.fit(COATED_METAL, _noisy(COATED_METAL, seed), progress=False)
+            # 4 starts: a smooth synthetic problem (the default 8 find the same optimum)
+            res = rb.fit(COATED_METAL, _noisy(COATED_METAL, seed), starts=4, progress=False)
         (c,) = res.channels
         assert c.success and not c.at_bound, (seed, c.message, c.at_bound)
         for nm in free:

@@ -37,14 +37,14 @@ def _rows(paint: str, res: rb.fitting.FitResult) -> list[str]:
         plaus = [r.plausibility(i) for i in range(len(r.channels))]
         incid = plaus[0].peak_theta_deg
         peaks = [_per_channel([p.peak_ratio[j] for p in plaus], ".2g") for j in range(len(incid))]
-        limits = sorted({nm for c in r.channels for nm, k in c.limits.items()
-                         if k.startswith("search")})
+        limits = r.search_limits
         name = f"**{cand.label}** (auto)" if cand is res.model_choice.best else cand.label
         if cand.partial:
             name += " (first channel only)"
         sig = _per_channel([c.sigma for c in r.channels])
-        rows.append(f"| {paint} | {name} | {r.loss} | {sig} | {cand.rms_log:.3f} | "
-                    f"{cand.cv:.3f} | " + " | ".join(peaks) + " | "
+        cv = "-" if cand.cv is None else f"{cand.cv:.3f}"  # a candidate stopped unscored
+        rows.append(f"| {paint} | {name} | {r.loss} | {sig} | {cand.rms_log:.3f} | {cv} | "
+                    + " | ".join(peaks) + " | "
                     f"{max(p.max_albedo for p in plaus):.3f} | {', '.join(limits) or '-'} |")
     return rows
 

@@ -17,6 +17,7 @@ Where the expected numbers come from:
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -314,6 +315,13 @@ def test_rank_by_score_bic_beside_energy_gain_last():
     # NaN (a single incidence) is no score either
     ranked, criterion = rank([_candidate("a", math.nan, -10.0), _candidate("b", 0.1, -5.0)])
     assert criterion == "bic" and [c.label for c in ranked] == ["a", "b"]
+    # a candidate stopped unscored on the first channel (auto, a search limit: partial) does
+    # not take the score away from the whole ones; it ranks after a partial one with a score
+    stopped = dataclasses.replace(_candidate("s", None, -99.0, limited=True), partial="stopped")
+    skipped = dataclasses.replace(_candidate("k", 0.9, -1.0), partial="skipped")
+    ranked, criterion = rank([stopped, _candidate("a", 0.3, -10.0), skipped,
+                              _candidate("b", 0.2, -5.0)])
+    assert criterion == "cv" and [c.label for c in ranked] == ["b", "a", "k", "s"]
 
 
 def test_a_candidate_on_a_search_limit_ranks_after_those_without():
@@ -375,3 +383,20 @@ def test_candidates_of_different_losses_are_scored_on_one_yardstick():
     assert not any("different losses" in n for n in same.notes)
     assert same.best.cv == pytest.approx(cross_validate(same.best.result, {"starts": 1}),
                                          rel=1e-9)
+
+
+def test_a_fold_without_statistics_is_the_same_fit():
+    # a cross-validation fold only predicts (compare._fold: statistics=False): the same
+    # parameters and figures of merit to the last bit, no covariance (NaN errors, a note)
+    from roughbrdf.fitting.kinds.channels import fit_model
+    from roughbrdf.fitting.problem.options import FitOptions
+
+    meas = _measurement()
+    opts = FitOptions(starts=2, progress=False)
+    full = fit_model("coated", meas, opts)
+    lean = fit_model("coated", meas, opts, statistics=False)
+    a, b = full.channels[0], lean.channels[0]
+    assert a.params == b.params and a.chi2 == b.chi2 and a.scale == b.scale
+    assert all(math.isfinite(v) for v in a.stderr.values() if v is not None)
+    assert all(math.isnan(v) for v in b.stderr.values() if v is not None)
+    assert "no covariance (a cross-validation fold)" in b.message

@@ -110,4 +110,7 @@ def test_auto_does_not_finish_a_candidate_stopped_on_a_search_limit():
     coated = rows[rb.models.spec_text(rb.models.from_spec(coat))]
     assert coated.partial is not None and "on a search limit" in coated.partial, coated.partial
     assert [c.channel for c in coated.result.channels] == ["a"]
+    # nor are its first-channel folds computed: no score, and the others still rank by theirs
+    assert coated.cv is None and "not scored" in coated.partial
+    assert res.model_choice.criterion == "cv" and res.model_choice.candidates[-1] is coated
     assert [c.channel for c in res.channels] == ["a", "b"] and not res.at_search_limit

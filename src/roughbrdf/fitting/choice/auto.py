@@ -14,11 +14,12 @@ choice"):
    says so (:attr:`~roughbrdf.fitting.choice.compare.Candidate.partial`), and it ranks after
    every whole candidate. So is a candidate with a parameter on a search limit on the first
    channel (while another has none): the whole fit would have it too and rank after every
-   candidate without one, whatever its score. The others are fitted to the remaining
-   channels, the search going on from the first channel as in one whole fit (the same
-   subsample draws, the first
-   channel's optimum as the warm start: the fit is the one ``compare`` makes), and scored over
-   all channels as ``compare`` scores them, the first channel's folds not refitted.
+   candidate without one, whatever its score; its first-channel folds are not computed
+   either (the row has no CV score and ranks after the scored ones). The others are fitted
+   to the remaining channels, the search going on from the first channel as in one whole
+   fit (the same subsample draws, the first channel's optimum as the warm start: the fit is
+   the one ``compare`` makes), and scored over all channels as ``compare`` scores them, the
+   first channel's folds not refitted.
 
 Why: model choice cost 12x one ``coated`` fit, and a candidate that predicts the first channel
 3x worse than the best (TR75 on the shared paints) never won on the whole file. The margin is
@@ -30,6 +31,7 @@ is the one of the whole comparison.
 from __future__ import annotations
 
 import dataclasses
+import math
 import warnings
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
@@ -114,42 +116,50 @@ def _in_two_stages(measurement: Measurement, models: list[Model], options: FitOp
     metric, losses = score_metric(models, options)
     first = channel_indices(measurement, options.channel)[0]
     opt1 = options.replace(channel=[first])
-    first_rows, helds = [], []
-    for m in models:
+    fits = [fit_model(m, measurement, opt1, check_energy=False) for m in models]
+    # a search limit on the first channel stays one of the whole fit: it would rank after
+    # every candidate without one (compare.rank), whatever its score; so it is not scored
+    # (its folds would be spent on a row that cannot win) while another candidate has none
+    limited = [r.at_search_limit for r in fits]
+    stop_limited = not all(limited)
+    rows: list[Candidate] = []
+    helds: list[np.ndarray | None] = []
+    for m, res, lim in zip(models, fits, limited, strict=True):
         label = spec_text(m)
-        res = fit_model(m, measurement, opt1, check_energy=False)
-        helds.append(held_out_residuals(res, opt1, label=label, metric=metric))
-        first_rows.append(candidate(label, res, rms(helds[-1])))
-    scores = [rms(h) for h in helds]
+        if stop_limited and lim:
+            rows.append(candidate(label, res, None, partial=(
+                f"fitted to channel {res.channels[0].channel} only, not scored: "
+                f"{', '.join(res.search_limits)} on a search limit there; it would rank after "
+                f"the candidates without one")))
+            helds.append(None)
+            continue
+        held = held_out_residuals(res, opt1, label=label, metric=metric)
+        helds.append(held)
+        rows.append(candidate(label, res, rms(held)))
+    scores = [math.nan if h is None else rms(h) for h in helds]
     # the margin is counted from the best candidate that can be kept: not one that gains
     # energy or stopped on a search limit (both rank after the others, compare.rank)
-    sound = [s for s, r in zip(scores, first_rows, strict=True)
-             if not r.gains_energy and not r.result.at_search_limit]
-    best = min(sound or scores)
-    rows: list[Candidate] = []
-    for m, first_row, held, score in zip(models, first_rows, helds, scores, strict=True):
+    sound = [s for s, r, lim in zip(scores, rows, limited, strict=True)
+             if not r.gains_energy and not lim]
+    pool = sound or [s for s in scores if not math.isnan(s)]
+    best = min(pool) if pool else math.nan  # NaN: no score, every candidate skipped below
+    out: list[Candidate] = []
+    for m, first_row, first_held, score in zip(models, rows, helds, scores, strict=True):
         label, res = first_row.label, first_row.result
-        channel = res.channels[0].channel
-        if not score <= best * (1 + SKIP_MARGIN):  # NaN: skipped too
-            rows.append(dataclasses.replace(first_row, partial=(
-                f"fitted to channel {channel} only: its score there ({score:.4g}) is more "
-                f"than {SKIP_MARGIN:.0%} above the best's ({best:.4g})")))
+        if first_held is None:  # stopped on a search limit (above)
+            out.append(first_row)
             continue
-        if sound and res.at_search_limit:
-            # a search limit on the first channel stays one of the whole fit: it would rank
-            # after every candidate without one (compare.rank), whatever its score
-            names = ", ".join(sorted(nm for c in res.channels for nm, k in c.limits.items()
-                                     if k.startswith("search")))
-            rows.append(dataclasses.replace(first_row, partial=(
-                f"fitted to channel {channel} only: {names} on a search limit there; it "
-                f"would rank after the candidates without one")))
+        if not score <= best * (1 + SKIP_MARGIN):  # NaN: skipped too
+            out.append(dataclasses.replace(first_row, partial=(
+                f"fitted to channel {res.channels[0].channel} only: its score there "
+                f"({score:.4g}) is more than {SKIP_MARGIN:.0%} above the best's ({best:.4g})")))
             continue
         # the other channels, the search going on from the first as in one whole fit: the
         # same fit as compare's, and the first channel's folds are not refitted
         whole = fit_model(m, measurement, options, check_energy=False, done=res.channels)
         whole.elapsed += res.elapsed
         more = dataclasses.replace(whole, channels=whole.channels[1:])
-        held_all = np.concatenate([held, held_out_residuals(more, options, label=label,
+        held_all = np.concatenate([first_held, held_out_residuals(more, options, label=label,
                                                             metric=metric)])
-        rows.append(candidate(label, whole, rms(held_all)))
-    return comparison(rows, measurement, losses)
+        out.append(candidate(label, whole, rms(held_all)))
+    return comparison(out, measurement, losses)

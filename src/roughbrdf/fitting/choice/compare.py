@@ -158,8 +158,7 @@ class Candidate:
     @property
     def search_limits(self) -> list[str]:
         """The parameters (of any channel) that ended on a search limit."""
-        return sorted({nm for c in self.result.channels for nm, k in c.limits.items()
-                       if k.startswith("search")})
+        return self.result.search_limits
 
 
     @property
@@ -373,7 +372,9 @@ def _fold(result: FitResult, options: FitOptions, train: Measurement, out: np.nd
             channel=[c.channel for c in group], starts=1, progress=False, subsample=None,
             joint=joint, shared=result.options["joint"]["shared"] if joint else None,
             weights=weights)
-        fold = fit_model(group[0].model, train, fold_options, check_energy=False, refit=True)
+        # only the fold's parameters are used (its prediction): no covariance
+        fold = fit_model(group[0].model, train, fold_options, check_energy=False, refit=True,
+                         statistics=False)
         for c, fc in zip(group, fold.channels, strict=True):
             idx = c.index[out[c.index]]
             if idx.size == 0:
@@ -522,22 +523,33 @@ def comparison(rows: list[Candidate], measurement: Measurement, losses: set[str]
 
 def rank(rows: Sequence[Candidate]) -> tuple[list[Candidate], str]:
     """The candidates best first and the criterion (module notes): ``"cv"`` when every
-    candidate has a finite cross-validation score, else ``"bic"``; those that gain energy
+    candidate fitted on all channels has a finite cross-validation score, else ``"bic"``
+    (a candidate stopped unscored ranks after the scored ones); those that gain energy
     last, before them those with a parameter on a search limit (where the search stopped, not
     a result of the model: ``docs/fitting.md``, "Parameters at a bound"); one fitted on part of
     the channels (:attr:`Candidate.partial`) after every whole one. Ties keep the given
     order."""
-    cv = all(c.cv is not None and math.isfinite(c.cv) for c in rows)
+    whole = [c for c in rows if c.partial is None] or list(rows)
+    cv = all(_scored(c) for c in whole)
     criterion = "cv" if cv else "bic"
 
     def key(c: Candidate) -> tuple[bool, bool, bool, float, int]:
         # equal scores (a lobe switched off: the smaller model's fit): the fewer unknowns;
-        # a candidate fitted on the first channel only (skipped) after every whole one
-        score = float(f"{c.cv:.6g}") if cv else c.bic  # type: ignore[arg-type]
+        # a candidate fitted on the first channel only (skipped) after every whole one, and
+        # one stopped unscored (a search limit, auto's first stage) after the scored ones
+        if cv:
+            score = float(f"{c.cv:.6g}") if _scored(c) else math.inf  # type: ignore[arg-type]
+        else:
+            score = c.bic
         return (c.partial is not None, c.gains_energy, bool(c.result.at_search_limit), score,
                 c.k)
 
     return sorted(rows, key=key), criterion
+
+
+def _scored(c: Candidate) -> bool:
+    """Whether ``c`` has a finite cross-validation score."""
+    return c.cv is not None and math.isfinite(c.cv)
 
 
 def choice_notes(cmp: ModelComparison) -> list[str]:

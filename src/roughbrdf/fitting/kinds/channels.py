@@ -59,7 +59,7 @@ def refuse_polarimetric_weight(options: FitOptions) -> None:
 
 def fit_model(model: Model | str, measurement: Measurement, options: FitOptions, *,
               check_energy: bool = True, refit: bool = False,
-              done: list[ChannelFit] | None = None) -> FitResult:
+              done: list[ChannelFit] | None = None, statistics: bool = True) -> FitResult:
     """Fit one model (an instance, a name or a spec; not ``"auto"``) with ``options``:
     Mueller data with :func:`~roughbrdf.fitting.kinds.polarimetric.fit_mueller`, others with
     :func:`fit_channels`. With ``check_energy``, an
@@ -71,7 +71,10 @@ def fit_model(model: Model | str, measurement: Measurement, options: FitOptions,
     (:func:`~roughbrdf.fitting.energy.refit_constrained`). ``done``: the fits of the first
     channels, made before by this same call with those channels alone
     (:mod:`~roughbrdf.fitting.choice.auto`'s first stage): kept as they are, and the search goes on
-    from them as it would have (:func:`fit_channels`); the result is the whole fit's."""
+    from them as it would have (:func:`fit_channels`); the result is the whole fit's.
+    ``statistics=False`` (a cross-validation fold: only its parameters are used): the channels
+    carry no covariance (:meth:`~roughbrdf.fitting.results.result.ChannelFit.fields_at_optimum`;
+    data that are not Mueller elements)."""
     res: FitResult
     if is_mueller(measurement):  # Mueller elements: all at once
         res = fit_mueller(model, measurement, options=options)
@@ -79,7 +82,8 @@ def fit_model(model: Model | str, measurement: Measurement, options: FitOptions,
         refuse_polarimetric_weight(options)
         m = as_model(model)
         res = (_by_wavelength(m, measurement, options, done) if needs_wavelength(m)
-               else fit_channels(m, measurement, options, refit=refit, done=done))
+               else fit_channels(m, measurement, options, refit=refit, done=done,
+                                 statistics=statistics))
     if check_energy:
         warn_energy(res, stacklevel=4)
     return res
@@ -104,10 +108,11 @@ def _by_wavelength(model: Model, measurement: Measurement, options: FitOptions,
 
 
 def fit_channels(model: Model, measurement: Measurement, options: FitOptions, *,
-                 refit: bool = False, done: list[ChannelFit] | None = None) -> FitResult:
+                 refit: bool = False, done: list[ChannelFit] | None = None,
+                 statistics: bool = True) -> FitResult:
     """Fit ``model`` to the channels of ``measurement`` (not Mueller data), each on its own
-    or, with ``options.joint``, all at once; ``refit`` and ``done`` as :func:`fit_model`'s
-    (``done`` is for channels fitted on their own)."""
+    or, with ``options.joint``, all at once; ``refit``, ``done`` and ``statistics`` as
+    :func:`fit_model`'s (``done`` and ``statistics`` are for channels fitted on their own)."""
     t_start = time.perf_counter()
     chans = channel_indices(measurement, options.channel)
     plan = FitPlan.of(model, measurement, options)
@@ -125,7 +130,8 @@ def fit_channels(model: Model, measurement: Measurement, options: FitOptions, *,
             results, summary = fit_joint(spec, data, search, options.shared, tick)
         else:
             results, summary = _separately(spec, search, data, bar, tick,
-                                           options.energy_constraint, refit, done), None
+                                           options.energy_constraint, refit, done,
+                                           statistics), None
     return FitResult(channels=results, **plan.result_fields(
         measurement, time.perf_counter() - t_start, joint=summary,
         energy_constraint=options.energy_constraint and not joint))
@@ -133,13 +139,15 @@ def fit_channels(model: Model, measurement: Measurement, options: FitOptions, *,
 
 def _separately(spec: ObjectiveSpec, search: SearchOptions, data: list[ChannelData],
                 bar: Any, tick: Any, energy: bool = True, refit: bool = False,
-                done: list[ChannelFit] | None = None) -> list[ChannelFit]:
+                done: list[ChannelFit] | None = None, statistics: bool = True
+                ) -> list[ChannelFit]:
     """Each channel on its own, in order (the previous optimum is a warm start); with
     ``energy``, a channel whose model gains energy refitted under the constraint; with
     ``refit``, a model that cannot guarantee energy refitted from its values under the
     constraint directly (:func:`~roughbrdf.fitting.energy.refit_constrained`). The fits
     ``done`` of the first channels are kept, and the search state they left is restored: the
-    subsample draws they made, their optimum as the next warm start."""
+    subsample draws they made, their optimum as the next warm start. ``statistics=False``:
+    no covariance (:func:`fit_model`)."""
     results: list[ChannelFit] = list(done or [])
     runner = MultiStart(spec, search, tick)
     for d, fit in zip(data, results, strict=False):
@@ -157,24 +165,28 @@ def _separately(spec: ObjectiveSpec, search: SearchOptions, data: list[ChannelDa
             direct = refit_constrained(spec, d, runner.start, search.max_nfev)
         if direct is not None:
             full = runner.objectives(d)[0]
-            fit = ChannelFit.from_search(full, direct[0], time.perf_counter() - t0)
-            results.append(_constrained(fit, full, direct[1]))
+            fit = ChannelFit.from_search(full, direct[0], time.perf_counter() - t0,
+                                         statistics=statistics)
+            results.append(_constrained(fit, full, direct[1], statistics))
             continue
         obj, outcome = runner.run(d)
         info = None
         if energy:
             outcome, info = constrain_channel(spec, d, outcome, search.max_nfev)
             runner.warm = outcome.theta.copy()  # the next channel starts from the result
-        fit = ChannelFit.from_search(obj, outcome, time.perf_counter() - t0)
-        results.append(fit if info is None else _constrained(fit, obj, info))
+        fit = ChannelFit.from_search(obj, outcome, time.perf_counter() - t0,
+                                     statistics=statistics)
+        results.append(fit if info is None else _constrained(fit, obj, info, statistics))
     return results
 
 
-def _constrained(fit: ChannelFit, obj: Any, info: EnergyConstraint) -> ChannelFit:
+def _constrained(fit: ChannelFit, obj: Any, info: EnergyConstraint,
+                 statistics: bool = True) -> ChannelFit:
     """``fit`` at a constrained optimum: its covariance conditional on the active
-    constraints, the message saying so, and ``info`` kept (``fit.json``)."""
+    constraints (with ``statistics``), the message saying so, and ``info`` kept
+    (``fit.json``)."""
     active = [EXPORT_INCIDENCES_DEG.index(t) for t in info.theta_deg]
-    out = conditional_covariance(fit, obj, active) if info.satisfied else fit
+    out = conditional_covariance(fit, obj, active) if info.satisfied and statistics else fit
     out.message += info.note()
     out.energy_constraint = info
     return out

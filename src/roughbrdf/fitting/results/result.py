@@ -155,28 +155,41 @@ class ChannelFit:
                 "n_points": self.n_points, "n_varys": self.n_varys}
 
     @classmethod
-    def from_search(cls, obj: Objective, outcome: SearchOutcome, elapsed: float) -> ChannelFit:
+    def from_search(cls, obj: Objective, outcome: SearchOutcome, elapsed: float, *,
+                    statistics: bool = True) -> ChannelFit:
         """The channel's result at the search's optimum: statistics on all samples of ``obj``
-        (:mod:`~roughbrdf.fitting.results.statistics`)."""
+        (:mod:`~roughbrdf.fitting.results.statistics`); ``statistics=False`` as
+        :meth:`fields_at_optimum`'s."""
         f = obj.values(outcome.theta)
-        return cls(**cls.fields_at_optimum(obj, outcome, elapsed, f, obj.data.values, f))
+        return cls(**cls.fields_at_optimum(obj, outcome, elapsed, f, obj.data.values, f,
+                                           statistics=statistics))
 
     @staticmethod
     def fields_at_optimum(obj: Objective, outcome: SearchOutcome, elapsed: float,
-                          f: np.ndarray, data: np.ndarray, fitted: np.ndarray
-                          ) -> dict[str, Any]:
+                          f: np.ndarray, data: np.ndarray, fitted: np.ndarray, *,
+                          statistics: bool = True) -> dict[str, Any]:
         """The fields of a :class:`ChannelFit` at the search's optimum, from the model values
         ``f`` of ``obj`` there; ``data`` and ``fitted`` are what the figures of merit (sigma,
-        rms-log) compare (the measured and model values; for Mueller data their m00)."""
+        rms-log) compare (the measured and model values; for Mueller data their m00).
+        ``statistics=False`` (a cross-validation fold, whose parameters only predict the
+        left-out incidence): no covariance, no bound or undetermined flags (NaN errors),
+        which saves the ``2 k`` model evaluations of the central-difference Jacobian."""
         spec, theta = obj.spec, outcome.theta
         fitted_model = spec.model_at(theta)
         k = obj.scale(f)
         r = obj.residual_of(f, k)
         gof = GoodnessOfFit.of(r, data, fitted, scale=k, n_varys=spec.n_varys,
                                floor=obj.floor)
-        bound, none, jac = bound_and_undetermined(obj, theta, k, r)
-        cov = Covariance.at_optimum(obj, theta, f, k, chi2=gof.chi2, dof=gof.dof,
-                                    held=[*bound, *none], jac=jac)
+        bound: dict[str, str] = {}
+        none: list[str] = []
+        if statistics:
+            bound, none, jac = bound_and_undetermined(obj, theta, k, r)
+            cov = Covariance.at_optimum(obj, theta, f, k, chi2=gof.chi2, dof=gof.dof,
+                                        held=[*bound, *none], jac=jac)
+        else:
+            names = [*spec.free, *(["scale"] if spec.free_scale else [])]
+            cov = Covariance(np.full((len(names), len(names)), np.nan), names,
+                             "; no covariance (a cross-validation fold)")
         sd = cov.stderr()
         stderr: dict[str, float | None] = dict.fromkeys(spec.model.param_names)
         stderr.update({nm: float(s) for nm, s in zip(cov.names, sd, strict=True) if nm != "scale"})
@@ -286,7 +299,14 @@ class FitResult:
     @property
     def at_search_limit(self) -> bool:
         """Whether a parameter of some channel ended on a search limit (not a result)."""
-        return any(k.startswith("search") for c in self.channels for k in c.limits.values())
+        return bool(self.search_limits)
+
+    @property
+    def search_limits(self) -> list[str]:
+        """The parameters that ended on a search limit in some channel, sorted (where the
+        search stopped, not a result: ``docs/fitting.md``, "Parameters at a bound")."""
+        return sorted({nm for c in self.channels for nm, k in c.limits.items()
+                       if k.startswith("search")})
 
     @property
     def gains_energy(self) -> bool:

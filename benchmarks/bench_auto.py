@@ -21,11 +21,15 @@ import os
 import sys
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 import roughbrdf as rb
+from roughbrdf.fitting.choice import auto as auto_module
 from roughbrdf.fitting.choice.auto import fit_auto
+from roughbrdf.models import spec_text
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # run.py loads by path
 from machine import cpu_name, load, vector_width  # noqa: E402
@@ -47,6 +51,69 @@ def best(call: Callable[[], object]) -> float:
         call()
         times.append(time.perf_counter() - t0)
     return min(times)
+
+
+@contextmanager
+def timed_stages() -> Iterator[list[dict[str, Any]]]:
+    """Record every fit and every set of folds that ``fit_auto``'s two stages make: the
+    module's ``fit_model`` and ``held_out_residuals`` wrapped for the duration (a benchmark's
+    probe; the library is not changed). Each record: ``what`` ("fit" or "folds"), ``model``,
+    ``stage`` (1: the first channel, 2: the others), seconds and model evaluations."""
+    log: list[dict[str, Any]] = []
+    fit, held = auto_module.fit_model, auto_module.held_out_residuals
+
+    def fit_probe(model: Any, *args: Any, **kw: Any) -> Any:
+        t0 = time.perf_counter()
+        res = fit(model, *args, **kw)
+        new = res.channels[len(kw.get("done") or []):]
+        log.append({"what": "fit", "model": spec_text(model), "stage": 2 if kw.get("done")
+                    else 1, "s": time.perf_counter() - t0, "nfev": sum(c.nfev for c in new)})
+        return res
+
+    def held_probe(res: Any, *args: Any, **kw: Any) -> Any:
+        t0 = time.perf_counter()
+        out = held(res, *args, **kw)
+        stage = 1 if len(res.channels) == 1 and res.channels[0].channel == \
+            res.measurement.channels[0] else 2
+        log.append({"what": "folds", "model": kw.get("label") or res.model_name,
+                    "stage": stage, "s": time.perf_counter() - t0, "nfev": None})
+        return out
+
+    auto_module.fit_model, auto_module.held_out_residuals = fit_probe, held_probe
+    try:
+        yield log
+    finally:
+        auto_module.fit_model, auto_module.held_out_residuals = fit, held
+
+
+def breakdown(meas: rb.Measurement, coated: float) -> None:
+    """Where one ``rb.fit("auto")`` spends its time: per candidate, the first channel's fit
+    and folds (stage 1), the other channels' fit and folds (stage 2), in seconds and in
+    units of one coated fit of the same run; the rest (ranking, albedo checks) as the
+    remainder."""
+    with timed_stages() as log:
+        t0 = time.perf_counter()
+        res = rb.fit("auto", meas, progress=False)
+        total = time.perf_counter() - t0
+    print(f"\nWhere the time goes (one run; total {total:.2f} s = {total / coated:.1f}x one "
+          f"coated fit; kept: {res.model_name})\n")
+    print("| candidate | stage 1 fit (s, evaluations) | stage 1 folds (s) | stage 2 fit (s, "
+          "evaluations) | stage 2 folds (s) | sum (x coated) |\n|---|---|---|---|---|---|")
+    models = list(dict.fromkeys(r["model"] for r in log))
+    for m in models:
+        cell = {}
+        for what in ("fit", "folds"):
+            for stage in (1, 2):
+                rows = [r for r in log if r["model"] == m and r["what"] == what
+                        and r["stage"] == stage]
+                cell[what, stage] = "-" if not rows else (
+                    f"{rows[0]['s']:.2f}" + (f", {rows[0]['nfev']}" if what == "fit" else ""))
+        spent = sum(r["s"] for r in log if r["model"] == m)
+        print(f"| {m} | {cell['fit', 1]} | {cell['folds', 1]} | {cell['fit', 2]} | "
+              f"{cell['folds', 2]} | {spent:.2f} ({spent / coated:.1f}x) |")
+    rest = total - sum(r["s"] for r in log)
+    print(f"| the rest (ranking, albedo of the rows) | | | | | {rest:.2f} "
+          f"({rest / coated:.1f}x) |")
 
 
 def main() -> None:
@@ -80,6 +147,7 @@ def main() -> None:
     print("| run | time (s) | ratio to one coated fit |\n|---|---|---|")
     for label, t in times.items():
         print(f"| {label} | {t:.2f} | {t / coated:.1f}x |", flush=True)
+    breakdown(meas, coated)
     print(f"\nload average after: {load()}")
 
 

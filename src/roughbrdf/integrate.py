@@ -18,6 +18,7 @@ of all incidences are evaluated in one vectorized model call.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -40,6 +41,53 @@ def _rho_panels(n_panels: int, order: int) -> tuple[np.ndarray, np.ndarray]:
         nodes.append(0.5 * (b - a) * x + 0.5 * (a + b))
         weights.append(0.5 * (b - a) * w)
     return np.concatenate(nodes), np.concatenate(weights)
+
+
+#: quadratures of at most this many samples are kept (:func:`_quadrature`): the ten
+#: incidences of every fit's plausibility check (7.4e5 samples, 18 MB), not larger grids
+CACHED_SAMPLES = 1_000_000
+
+
+def _quadrature(ti_bytes: bytes, n_psi: int, n_panels: int, order: int
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(theta_r, phi, weight)`` of the rule (module notes) at the incidences ``ti_bytes``
+    (float64 radians, as bytes), shape ``(incidences, n_psi, n_panels * order)``; the albedo
+    is ``sum(f cos theta_r * weight)`` over the last two axes. Grids of at most
+    :data:`CACHED_SAMPLES` samples are cached (:func:`_quadrature_cached`): every fit checks
+    its channels' albedo at the same ten incidences, and building the directions (``arccos``,
+    ``arctan2`` of every sample) cost as much as evaluating a coated model on them."""
+    n = len(ti_bytes) // 8 * n_psi * n_panels * order
+    if n <= CACHED_SAMPLES:
+        return _quadrature_cached(ti_bytes, n_psi, n_panels, order)
+    return _build_quadrature(ti_bytes, n_psi, n_panels, order)
+
+
+def _build_quadrature(ti_bytes: bytes, n_psi: int, n_panels: int, order: int
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_quadrature`, built."""
+    t = np.frombuffer(ti_bytes, dtype=float).reshape(-1, 1, 1)
+    u, wu = _rho_panels(n_panels, order)  # fraction of rho_max
+    psi = (np.arange(n_psi) + 0.5) * (2 * math.pi / n_psi)
+    cp, sp = np.cos(psi)[None, :, None], np.sin(psi)[None, :, None]
+    # specular direction w_s and the orthonormal pair (e1, e2) perpendicular to it
+    sz, sx = np.cos(t), np.sin(t)
+    # tangent direction t(psi) = cos psi e1 + sin psi e2, e1 = (cos ti, 0, -sin ti), e2 = y
+    tx, ty, tz = cp * sz, sp, -cp * sx
+    # horizon: w_z = cos(rho) sz + sin(rho) tz = 0  ->  rho_max = atan2(sz, -tz) in (0, pi]
+    rho_max = np.arctan2(sz, -tz)
+    rho = u[None, None, :] * rho_max
+    cr_, sr_ = np.cos(rho), np.sin(rho)
+    wx = cr_ * sx + sr_ * tx
+    wy = sr_ * ty
+    wz = np.clip(cr_ * sz + sr_ * tz, 0.0, 1.0)
+    weight = sr_ * rho_max * wu[None, None, :] * (2 * math.pi / n_psi)
+    out = (np.arccos(wz), np.arctan2(wy, wx), weight)
+    for a in out:
+        a.setflags(write=False)  # shared by every call (cached)
+    return out
+
+
+_quadrature_cached = functools.lru_cache(maxsize=2)(_build_quadrature)
 
 
 def albedo(model: Model, theta_i: ArrayLike, *, polarization=None, n_psi: int = 256,
@@ -68,29 +116,12 @@ def albedo(model: Model, theta_i: ArrayLike, *, polarization=None, n_psi: int = 
         raise ArgumentError("polarization", "albedo takes one polarization for all "
                             "incidences (a name or one angle gamma)")
     shape = ti.shape
-    t = ti.reshape(-1, 1, 1)
-    u, wu = _rho_panels(n_panels, order)  # fraction of rho_max
-    psi = (np.arange(n_psi) + 0.5) * (2 * math.pi / n_psi)
-    cp, sp = np.cos(psi)[None, :, None], np.sin(psi)[None, :, None]
-    # specular direction w_s and the orthonormal pair (e1, e2) perpendicular to it
-    sz, sx = np.cos(t), np.sin(t)
-    # tangent direction t(psi) = cos psi e1 + sin psi e2, e1 = (cos ti, 0, -sin ti), e2 = y
-    tx, ty, tz = cp * sz, sp, -cp * sx
-    # horizon: w_z = cos(rho) sz + sin(rho) tz = 0  ->  rho_max = atan2(sz, -tz) in (0, pi]
-    rho_max = np.arctan2(sz, -tz)
-    rho = u[None, None, :] * rho_max
-    cr_, sr_ = np.cos(rho), np.sin(rho)
-    wx = cr_ * sx + sr_ * tx
-    wy = sr_ * ty
-    wz = np.clip(cr_ * sz + sr_ * tz, 0.0, 1.0)
-    theta_r = np.arccos(wz)
-    phi = np.arctan2(wy, wx)
-    # the directions are built here inside the hemisphere: no second validation
-    g = PreparedGeometry(np.broadcast_to(t, theta_r.shape), theta_r, phi, gamma)
+    theta_r, phi, weight = _quadrature(ti.tobytes(), n_psi, n_panels, order)
+    # the directions are built inside the hemisphere: no second validation
+    g = PreparedGeometry(np.broadcast_to(ti.reshape(-1, 1, 1), theta_r.shape), theta_r, phi,
+                         gamma)
     f = model.evaluate_prepared(g, "brdf_cos")
-    integrand = f * sr_ * rho_max * wu[None, None, :]
-    out = integrand.sum(axis=(1, 2)) * (2 * math.pi / n_psi)
-    out = out.reshape(shape)
+    out = (f * weight).sum(axis=(1, 2)).reshape(shape)
     return float(out) if out.ndim == 0 else out
 
 

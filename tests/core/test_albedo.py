@@ -136,3 +136,31 @@ def test_invalid_incidence_raises():
         rb.albedo(rb.model("tr75"), math.pi / 2)  # TR75 divides by cos(theta_i)
     with pytest.raises(ValueError, match=r"theta_i.*-0\.1"):
         rb.albedo(rb.model("lambertian"), -0.1)
+
+
+def test_the_cached_rule_is_the_rule():
+    # integrate._quadrature caches grids up to CACHED_SAMPLES (every fit's plausibility check
+    # integrates at the same ten incidences): the cached grid gives the albedo of the grid
+    # built afresh to the last bits, a second call the same, and other incidences their own
+    from roughbrdf import integrate
+
+    model = rb.model("coated", n=1.5, rho=0.4, alpha=0.08)
+    theta = np.radians([0.0, 40.0, 85.0])
+    integrate._quadrature_cached.cache_clear()
+    first = rb.albedo(model, theta)
+    assert integrate._quadrature_cached.cache_info().currsize == 1
+    again = rb.albedo(model, theta)
+    theta_r, phi, weight = integrate._build_quadrature(theta.tobytes(), 256, 24, 12)
+    fresh = (model.brdf(theta[:, None, None], theta_r, phi) * np.cos(theta_r)
+             * weight).sum(axis=(1, 2))
+    np.testing.assert_array_equal(first, again)
+    np.testing.assert_allclose(first, fresh, rtol=1e-12)  # brdf*cos vs brdf_cos: rounding
+    other = rb.albedo(model, np.radians([0.0, 41.0, 85.0]))
+    assert other[0] == first[0] and other[2] == first[2] and other[1] != first[1]
+    # a grid above the cap is built each time and not kept
+    integrate._quadrature_cached.cache_clear()
+    big = rb.albedo(model, np.radians(np.arange(0.0, 89.0, 5.0)), n_psi=512)
+    assert integrate._quadrature_cached.cache_info().currsize == 0
+    assert np.all((big > 0) & (big < 1))
+    theta_r, _, weight = integrate._quadrature(theta.tobytes(), 256, 24, 12)
+    assert not theta_r.flags.writeable and not weight.flags.writeable  # shared: read-only

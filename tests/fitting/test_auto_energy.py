@@ -57,8 +57,14 @@ def test_auto_on_the_paints_reflects_at_most_what_it_receives(shared_data, paint
             a = np.asarray(rb.albedo(c.model, theta))
             assert np.all(a <= 1 + 1e-3), (cand.label, c.channel, a.max())
             assert c.success, (cand.label, c.channel, c.message)
-    scores = [c.cv for c in choice.candidates]
-    assert choice.criterion == "cv" and all(math.isfinite(s) for s in scores)
+    # every candidate scored, but one stopped on a search limit on the first channel (auto:
+    # not scored, fitted no further, ranked after the scored ones)
+    scored = [c for c in choice.candidates if c.cv is not None]
+    assert choice.criterion == "cv" and all(math.isfinite(c.cv) for c in scored)
+    for c in choice.candidates:
+        if c.cv is None:
+            assert c.partial and "not scored" in c.partial and c.result.at_search_limit
+            assert choice.candidates.index(c) >= len(scored)
     # ranked by the score among the candidates fitted whole without a search limit (a
     # skipped or stopped one, fitted to the first channel only, and one on a search limit
     # rank after them: compare.rank), the best of those kept

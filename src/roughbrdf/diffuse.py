@@ -124,9 +124,28 @@ def coated_diffuse(ci, cr, n, gamma, rho, fdr_int):
     (:func:`roughbrdf.fresnel.diffuse_reflectance`). For ``rho = 1`` the albedo is exactly
     ``1 - R(theta_i)``: all transmitted light comes back out.
     """
+    t_in, t_out = interface_transmission(ci, cr, n, gamma)
+    return diffuse_through(t_in, t_out, n, rho, fdr_int)
+
+
+@jit(inline=True)
+def interface_transmission(ci, cr, n, gamma):
+    """``(1 - R(theta_i; gamma), 1 - R(theta_r))``: the smooth interface's (index ``n``,
+    ``k = 0``) Fresnel transmittance at the macroscopic angles, at incidence for the incident
+    polarization ``gamma`` (the macroscopic planes of incidence coincide, ``eta = 0``), at
+    exit unpolarized. Shared by every layer under a smooth coat (:func:`coated_diffuse`, the
+    metallic paint's flakes and pigment)."""
     t_in = 1.0 - fresnel_polarized_cs(ci, n, 0.0, gamma, 1.0, 0.0)
     rs, rp = fresnel_sp(cr, n, 0.0)
-    t_out = 1.0 - 0.5 * (rs + rp)
+    return t_in, 1.0 - 0.5 * (rs + rp)
+
+
+@jit(inline=True)
+def diffuse_through(t_in, t_out, n, rho, fdr_int):
+    """``rho/pi t_in t_out / (n^2 (1 - rho F_int))``: a diffuse substrate of albedo ``rho``
+    under an interface of transmittances ``t_in``, ``t_out`` and internal reflectance
+    ``fdr_int`` (Weidlich & Wilkie; the light the interface reflects back down returns,
+    the geometric series ``1/(1 - rho F_int)``)."""
     return rho / math.pi * t_in * t_out / (n * n * (1.0 - rho * fdr_int))
 
 
@@ -150,9 +169,8 @@ def coated_diffuse_rough(ci, cr, n, rho, f_int, table, offset):
     ``T`` at ``table[offset:offset + 64]`` and the internal reflectance ``f_int`` from
     :func:`rough_interface` (Mitsuba 3's ``roughplastic`` with ``nonlinear=true``).
     """
-    t_in = table_lerp(ci, table, offset)
-    t_out = table_lerp(cr, table, offset)
-    return rho / math.pi * t_in * t_out / (n * n * (1.0 - rho * f_int))
+    return diffuse_through(table_lerp(ci, table, offset), table_lerp(cr, table, offset), n,
+                           rho, f_int)
 
 
 @jit

@@ -280,6 +280,14 @@ def half_vector(ti, tr, phi):
     si, ci = sincos(ti)  # vectorizable sin/cos (see roughbrdf._kernels.vmath.sincos)
     sr, cr = sincos(tr)
     sp, cp = sincos(phi)
+    return half_vector_cs(si, ci, sr, cr, sp, cp)
+
+
+@jit(inline=True)
+def half_vector_cs(si, ci, sr, cr, sp, cp):
+    """:func:`half_vector` from the sines and cosines of ``theta_i``, ``theta_r`` and ``phi``
+    (for directions known by them, e.g. refracted into a coat: ``sin theta' = sin theta/n``,
+    no ``asin``)."""
     # cos(pi/2) is 6e-17, not 0; clip so that exact grazing gives exactly zero cosines.
     ci = 0.0 if ci < 1e-15 else ci
     cr = 0.0 if cr < 1e-15 else cr

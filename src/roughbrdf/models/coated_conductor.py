@@ -16,7 +16,8 @@ Composed from the library's parts (``docs/models.md`` §10.5), nothing re-derive
   :func:`roughbrdf.diffuse.coated_diffuse`.
 * ``theta'``: the directions refracted into the coat, ``sin theta' = sin theta/n``, same
   azimuth; the flakes' half vector, ``theta_d'`` and ``theta_h'`` are
-  :func:`roughbrdf.geometry.half_vector` of the refracted pair.
+  :func:`roughbrdf.geometry.half_vector_cs` of the refracted pair (their sines and cosines,
+  no ``asin``).
 * base: the ``microfacet`` model (unpolarized ``F``, ``ks = 1``) of the conductor at the
   relative index ``(n_m + i k_m)/n`` with its own width ``alpha_m``; with ``diffuse=True`` a
   share ``d`` of pigment of albedo ``rho`` between the flakes.
@@ -41,16 +42,15 @@ from numba import prange
 from .. import distributions as dist
 from .. import shadowing as shd
 from .._kernels import at, driver, jit, sincos, tuple_slice
-from ..diffuse import coated_diffuse, table_lerp
+from ..diffuse import diffuse_through, interface_transmission, table_lerp
 from ..fresnel import (
     check_index,
     diffuse_reflectance,
-    fresnel_polarized_cs,
     fresnel_polarized_xy,
     fresnel_sp,
     index_from_reflectance,
 )
-from ..geometry import half_vector, tr75_eta_xy
+from ..geometry import half_vector_cs, tr75_eta_xy
 from .base import Model, register
 from .coated import lobe, smooth_interface_factors
 from .parameters import Parameter, nonnegative, option_flag, positive, reflectance
@@ -60,15 +60,20 @@ _TABLE0 = 12
 
 
 @jit(inline=True)
-def _flakes(ti, tr, phi, n, nm, km, am, norm, dcode, scode):
+def _flakes(si, sr, sp, cp, n, nm, km, am, norm, dcode, scode):
     """The conductor's microfacet BRDF at the directions refracted into the coat.
 
     ``F((n_m + i k_m)/n) D G/(4 cos theta_i' cos theta_r')`` (unpolarized ``F``: the light
-    inside is taken as unpolarized), ``sin theta' = sin theta/n``. ``n > 1``, so
-    ``cos theta' >= sqrt(1 - 1/n^2) > 0``: no division by 0 even at grazing outside.
+    inside is taken as unpolarized), ``sin theta' = sin theta/n`` (``si``, ``sr``, ``sp``,
+    ``cp``: the sines of the outside angles and of ``phi``, its cosine). ``n >= 1``, so
+    ``cos theta' >= sqrt(1 - 1/n^2)``: positive under a coat; without one (``n = 1``) it is
+    the outside cosine, 0 only at grazing, where Smith's ``G`` is 0 too.
     """
-    si, sr = sincos(ti)[0], sincos(tr)[0]
-    hx, hy, hz, cd, ci, cr, _ = half_vector(math.asin(si / n), math.asin(sr / n), phi)
+    si_, sr_ = si / n, sr / n
+    # 1 - s^2 >= 1 - 1/n^2 >= 0 for n >= 1: the max only guards rounding above 1
+    ci_ = math.sqrt(max(0.0, 1.0 - si_ * si_))
+    cr_ = math.sqrt(max(0.0, 1.0 - sr_ * sr_))
+    hx, hy, hz, cd, ci, cr, _ = half_vector_cs(si_, ci_, sr_, cr_, sp, cp)
     rs, rp = fresnel_sp(cd, nm, km)
     t = 0.5 * (rs + rp) * lobe(dcode, scode, am, 1.0, norm, hz, ci, cr)
     # t = 0 (F = 0 at an index-matched base, or D underflowed): 0, never 0 * inf
@@ -81,20 +86,21 @@ def _metallic_eval(ti, tr, phi, gamma, p, tab, flag, dcode):
     n, a, norm, nm, km, am, norm_m, dd, rho = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], \
         p[8]
     scode = int(p[9])
-    hx, hy, hz, cd, ci, cr, si = half_vector(ti, tr, phi)
+    si, ci0 = sincos(ti)
+    sr, cr0 = sincos(tr)
+    sp, cp = sincos(phi)
+    hx, hy, hz, cd, ci, cr, si = half_vector_cs(si, ci0, sr, cr0, sp, cp)
     ex, ey = tr75_eta_xy(si, ci, hx, hy, hz)
     f = fresnel_polarized_xy(cd, n, 0.0, gamma, ex, ey)
     coat = 0.25 * f * lobe(dcode, scode, a, 1.0, norm, hz, ci, cr)
     # the coat's lobe is 0 where its facets are (0 * inf is excluded by Smith G -> 0 at
     # grazing, as in the coated model)
-    t_in = 1.0 - fresnel_polarized_cs(ci, n, 0.0, gamma, 1.0, 0.0)
-    rs, rp = fresnel_sp(cr, n, 0.0)
-    t_out = 1.0 - 0.5 * (rs + rp)
-    flakes = (1.0 - dd) * t_in * t_out / (n * n) * _flakes(ti, tr, phi, n, nm, km, am,
+    t_in, t_out = interface_transmission(ci, cr, n, gamma)  # once: flakes and pigment
+    flakes = (1.0 - dd) * t_in * t_out / (n * n) * _flakes(si, sr, sp, cp, n, nm, km, am,
                                                           norm_m, dcode, scode)
     # the pigment: the coated model's diffuse substrate (its light trapped by the coat's
     # internal reflection comes back out, 1/(1 - rho F_dr,int)); dd = 0 without diffuse=True
-    pigment = dd * coated_diffuse(ci, cr, n, gamma, rho, p[11]) if dd > 0.0 else 0.0
+    pigment = dd * diffuse_through(t_in, t_out, n, rho, p[11]) if dd > 0.0 else 0.0
     layer = table_lerp(ci, tab, 0) * table_lerp(cr, tab, 0) * (flakes + pigment)
     value = coat + layer
     return value * cr if flag else value

@@ -5,10 +5,10 @@ Two compiled scalar parts, each used by every model that needs it (``docs/models
 * :func:`oren_nayar_factor` -- the factor ``A + B max(0, cos(phi_r - phi_i)) sin(alpha)
   tan(beta)`` of Oren & Nayar's qualitative model (1994, Eq. 30) that multiplies ``rho/pi``;
 * :func:`coated_diffuse` -- a diffuse substrate of albedo ``rho`` under a smooth dielectric
-  interface of index ``n``: Fresnel transmission into the coating at incidence and out of it
-  at exit, the ``1/n^2`` of radiance crossing the interface, and the internal reflections
-  between substrate and interface summed as a geometric series (Weidlich & Wilkie 2007, §3;
-  the form of Mitsuba 3's ``roughplastic`` with ``nonlinear=true``, ``docs/models.md`` §10.3);
+  interface of index ``n``: Fresnel transmission in and out (:func:`interface_transmission`),
+  the ``1/n^2`` of radiance crossing the interface, and the internal reflections summed as a
+  geometric series (:func:`diffuse_through`; Weidlich & Wilkie 2007, §3; the form of Mitsuba
+  3's ``roughplastic`` with ``nonlinear=true``, ``docs/models.md`` §10.3);
 * :func:`coated_diffuse_rough` -- the same substrate under the *rough* interface, with the
   transmission and the internal reflectance of the interface's single-scattering microfacet
   lobes, computed exactly as Mitsuba 3's ``roughplastic`` computes them
@@ -29,15 +29,12 @@ Mitsuba 3.9's ``roughplastic`` (``src/bsdfs/roughplastic.cpp``, ``parameters_cha
   total internal reflection included);
 
 each integral by a Gauss-Legendre product rule on the square of the visible-normal sampling
-routine (``sample_visible_11``: Heitz 2018 for GGX, Jakob 2014's numerical inversion with three
-Newton steps for Beckmann), 32 x 32 nodes for ``T`` and 128 x 128 for ``E``. The rule is
-Mitsuba's, node for node: a finer one would move ``T`` by up to ~4e-4 (measured against an
-adaptive quadrature of the same integral), which would break the one-to-one Mitsuba export
-(:mod:`roughbrdf.export.mitsuba`). The integrands are the library's own parts
-(:func:`roughbrdf.fresnel.fresnel_sp`, Smith ``G1`` from
-:func:`roughbrdf.distributions.lambda_cos`); for GGX they are Mitsuba's formulas, for Beckmann
-Mitsuba uses a rational approximation of ``G1`` (within 0.35 %; ``g1="mitsuba"`` reproduces it,
-for the export's deviation estimates). The substrate term is then
+routine (``sample_visible_11``: Heitz 2018 for GGX, Jakob 2014's inversion with three Newton
+steps for Beckmann), 32 x 32 nodes for ``T``, 128 x 128 for ``E``: Mitsuba's rule, node for
+node (a finer one moves ``T`` by up to ~4e-4 and would break the one-to-one Mitsuba export).
+The integrands are the library's parts (:func:`roughbrdf.fresnel.fresnel_sp`, Smith ``G1``
+from :func:`roughbrdf.distributions.lambda_cos`); Mitsuba's Beckmann ``G1`` is a rational
+approximation (within 0.35 %; ``g1="mitsuba"`` reproduces it). The substrate term is then
 ``rho/pi T(mu_i) T(mu_r) / (n^2 (1 - rho F_int))``, unpolarized.
 
 Conventions: the library's frame (``docs/models.md`` §1.1): ``phi = 0`` is the forward
@@ -61,8 +58,8 @@ from .fresnel import fresnel_polarized_cs, fresnel_sp
 from .geometry import check_angles
 
 __all__ = ["oren_nayar_factor", "coated_diffuse", "coated_diffuse_rough", "oren_nayar",
-           "lobe_albedo", "rough_interface", "ROUGH_TABLE_SIZE",
-           "TABLE_NODES", "ALBEDO_NODES_PER_DECADE", "FRESNEL_GRID_SIZE"]
+           "interface_transmission", "diffuse_through", "lobe_albedo", "rough_interface",
+           "ROUGH_TABLE_SIZE", "TABLE_NODES", "ALBEDO_NODES_PER_DECADE", "FRESNEL_GRID_SIZE"]
 
 #: table size of Mitsuba's roughplastic (``MI_ROUGH_TRANSMITTANCE_RES``): the rough interface's
 #: transmittance at 64 equally spaced values of cos(theta), interpolated linearly
@@ -80,11 +77,9 @@ _TWO_OVER_SQRT_PI = 2.0 / math.sqrt(math.pi)
 #: ``g1`` argument of :func:`rough_interface` -> code of the compiled table kernel
 G1_CODES = {"exact": 0, "mitsuba": 1}
 #: what a visible-normal sample of :func:`_lobe_sample` integrates: reflection inside the
-#: coating (index 1/n), transmission into it, reflection outside (separable or
-#: height-correlated Smith)
+#: coating (index 1/n), transmission into it, reflection outside (separable or correlated Smith)
 _INTERNAL, _TRANSMIT, _EXTERNAL_SEPARABLE, _EXTERNAL_CORRELATED = 0, 1, 2, 3
-#: Gauss-Legendre nodes per axis of :func:`lobe_albedo` (its integrand is smooth on the
-#: visible-normal square, 32 x 32 as for the transmittance)
+#: Gauss-Legendre nodes per axis of :func:`lobe_albedo` (a smooth integrand: 32 x 32)
 _NODES_ALBEDO = 32
 #: the grid of :func:`_albedo_smooth`: ``alpha = 10^(i/128)``, every integer ``i`` (built
 #: when first needed), and the Fresnel factor at ``cos = m/63``, m = 0..63
@@ -114,27 +109,19 @@ def oren_nayar_factor(ci, cr, si, sr, cos_phi, sigma2):
 
 @jit(inline=True)
 def coated_diffuse(ci, cr, n, gamma, rho, fdr_int):
-    """Diffuse substrate under a smooth dielectric interface, BRDF in sr⁻¹ (Weidlich & Wilkie).
-
-    ``rho/pi (1 - R(theta_i; gamma)) (1 - R(theta_r)) / (n^2 (1 - rho F_dr,int))`` with ``R``
-    the Fresnel reflectance of the interface (index ``n``, ``k = 0``) at the macroscopic
-    angles: at incidence for the incident polarization ``gamma`` (the macroscopic planes of
-    incidence coincide, ``eta = 0``), at exit unpolarized (an unpolarized detector);
-    ``fdr_int`` is the interface's internal diffuse reflectance
-    (:func:`roughbrdf.fresnel.diffuse_reflectance`). For ``rho = 1`` the albedo is exactly
-    ``1 - R(theta_i)``: all transmitted light comes back out.
-    """
+    """Diffuse substrate under a smooth dielectric interface, BRDF in sr⁻¹ (Weidlich & Wilkie):
+    :func:`diffuse_through` of :func:`interface_transmission`, ``fdr_int`` the interface's
+    internal diffuse reflectance (:func:`roughbrdf.fresnel.diffuse_reflectance`). For ``rho =
+    1`` the albedo is exactly ``1 - R(theta_i)``: all transmitted light comes back out."""
     t_in, t_out = interface_transmission(ci, cr, n, gamma)
     return diffuse_through(t_in, t_out, n, rho, fdr_int)
 
 
 @jit(inline=True)
 def interface_transmission(ci, cr, n, gamma):
-    """``(1 - R(theta_i; gamma), 1 - R(theta_r))``: the smooth interface's (index ``n``,
-    ``k = 0``) Fresnel transmittance at the macroscopic angles, at incidence for the incident
-    polarization ``gamma`` (the macroscopic planes of incidence coincide, ``eta = 0``), at
-    exit unpolarized. Shared by every layer under a smooth coat (:func:`coated_diffuse`, the
-    metallic paint's flakes and pigment)."""
+    """``(1 - R(theta_i; gamma), 1 - R(theta_r))``: a smooth interface's (index ``n``, ``k =
+    0``) Fresnel transmittance at the macroscopic angles, at incidence for the polarization
+    ``gamma`` (the planes of incidence coincide, ``eta = 0``), at exit unpolarized."""
     t_in = 1.0 - fresnel_polarized_cs(ci, n, 0.0, gamma, 1.0, 0.0)
     rs, rp = fresnel_sp(cr, n, 0.0)
     return t_in, 1.0 - 0.5 * (rs + rp)
@@ -142,10 +129,8 @@ def interface_transmission(ci, cr, n, gamma):
 
 @jit(inline=True)
 def diffuse_through(t_in, t_out, n, rho, fdr_int):
-    """``rho/pi t_in t_out / (n^2 (1 - rho F_int))``: a diffuse substrate of albedo ``rho``
-    under an interface of transmittances ``t_in``, ``t_out`` and internal reflectance
-    ``fdr_int`` (Weidlich & Wilkie; the light the interface reflects back down returns,
-    the geometric series ``1/(1 - rho F_int)``)."""
+    """``rho/pi t_in t_out / (n^2 (1 - rho F_int))``: a substrate of albedo ``rho`` under an
+    interface of transmittances ``t_in``, ``t_out`` and internal reflectance ``F_int``."""
     return rho / math.pi * t_in * t_out / (n * n * (1.0 - rho * fdr_int))
 
 

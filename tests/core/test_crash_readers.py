@@ -140,17 +140,17 @@ def _cli(args: list[str], folder: Path) -> tuple[int, tuple[str, str] | None]:
 
 
 def _read_plot(folder: Path, scratch: Path) -> Any:
-    from roughbrdf.fitting.results import result
+    from roughbrdf.fitting.results import fit_json
 
     seen: list[dict[str, Any]] = []
-    real = result.read_fit_json
+    real = fit_json.read_fit_json
 
     def spy(*args: Any, **kw: Any) -> Any:  # the fit.json content plot --fit draws from
         content, base = real(*args, **kw)
         seen.append(_untimed(content))
         return content, base
 
-    with mock.patch.object(result, "read_fit_json", spy):
+    with mock.patch.object(fit_json, "read_fit_json", spy):
         _code, refused = _cli(["plot", "--fit", str(folder), "--out",
                                str(scratch / "plot.png"), "--force"], folder)
     return refused or seen[0]

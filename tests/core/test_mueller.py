@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from mitsuba_support import mitsuba_variant
 
 import roughbrdf as rb
 from roughbrdf._kernels import DISABLE_JIT
@@ -580,9 +581,7 @@ def _mitsuba_mueller(mi, bsdf, ti, tr, ph):
 
 def test_mitsuba_polarized_roughconductor():
     mi, variant = _mitsuba_polarized()
-    previous = mi.variant()
-    mi.set_variant(variant)
-    try:
+    with mitsuba_variant(mi, variant):
         ti, tr, ph = geometries(40, 6, top=math.radians(80))
         for dist, mdist in (("trowbridge-reitz", "ggx"), ("beckmann", "beckmann")):
             bsdf = mi.load_dict({"type": "roughconductor", "distribution": mdist, "alpha": 0.3,
@@ -600,6 +599,3 @@ def test_mitsuba_polarized_roughconductor():
             assert keep.sum() >= 20
             np.testing.assert_allclose(got[keep] / got[keep, :1, :1],
                                        ref[keep] / ref[keep, :1, :1], rtol=0, atol=2e-5)
-    finally:
-        if previous is not None:
-            mi.set_variant(previous)

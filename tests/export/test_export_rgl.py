@@ -22,6 +22,7 @@ import math
 import numpy as np
 import pytest
 from conftest import MINIDIFF_PAINTS
+from mitsuba_support import mitsuba_variant
 
 import roughbrdf as rb
 from roughbrdf.errors import ArgumentError
@@ -54,11 +55,8 @@ MODELS = {
 @pytest.fixture(autouse=True)
 def scalar_rgb():
     """Mitsuba's ``scalar_rgb`` for each test, the variant before it restored after."""
-    before = mi.variant()
-    mi.set_variant("scalar_rgb")
-    yield
-    if before is not None:
-        mi.set_variant(before)
+    with mitsuba_variant(mi, "scalar_rgb"):
+        yield
 
 
 def directions(seed: int, n: int = N):

@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from mitsuba_support import mitsuba_variant
 
 import roughbrdf as rb
 
@@ -55,11 +56,8 @@ def render_rgl():
 @pytest.fixture(autouse=True)
 def scalar_rgb():
     """Mitsuba's ``scalar_rgb`` for each test, the variant before it restored after."""
-    before = mi.variant()
-    mi.set_variant("scalar_rgb")
-    yield
-    if before is not None:
-        mi.set_variant(before)
+    with mitsuba_variant(mi, "scalar_rgb"):
+        yield
 
 
 def test_the_python_plugin_is_the_model_and_agrees_with_the_file(render_rgl, tmp_path):

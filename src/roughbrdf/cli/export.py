@@ -47,7 +47,7 @@ def _source(model: str | None, param: list[str] | None, fit_dir: str | None,
             raise ValueError("-p sets a MODEL's parameters; a fit's models are as fitted")
         import json
 
-        from ..fitting.results.result import fitted_models
+        from ..fitting.results.fit_json import fitted_models
         from ..result_check import check_result_folder
 
         path = Path(fit_dir) / "fit.json" if Path(fit_dir).is_dir() else Path(fit_dir)

@@ -227,7 +227,7 @@ def _fit_figure(fit: dict[str, Any], fit_dir: Path, meas: Any, chan: dict[str, A
                 aperture: Any) -> Any:
     """Data vs model and the residual maps of one channel of the fit, on the fit's samples."""
     from .. import plot_fit
-    from ..fitting.results.result import channel_model
+    from ..fitting.results.fit_json import channel_model
 
     model = channel_model(fit, chan)
     label = chan.get("channel")
@@ -244,7 +244,7 @@ def _fit_figures(fit_dir: Path, out: Path | None, channel: str | None, force: bo
                  ) -> list[Path]:
     """Draw the comparison of each channel of the fit in ``fit_dir``: into ``out``, or added to
     the fit's results in its folder; everything is checked before the drawing."""
-    from ..fitting.results.result import check_fit_channels, read_fit_json
+    from ..fitting.results.fit_json import check_fit_channels, read_fit_json
     from ..output import ResultFolder
     from ..result_check import check_result_folder
 

@@ -76,7 +76,7 @@ def _fit_inputs(fit_dir: str) -> tuple[dict[str, Model], Measurement, str]:
         res = loader(fit_dir)
         models = {str(c.channel): c.model for c in res.channels}
         return models, res.measurement, res.report()
-    from ..fitting.results.result import fitted_models, read_fit_json
+    from ..fitting.results.fit_json import fitted_models, read_fit_json
 
     content, folder = read_fit_json(fit_dir)
     models = fitted_models(fit_dir)

@@ -87,7 +87,7 @@ def export(source: Any, out: str | os.PathLike, *, to: str, overwrite: bool = Fa
     ----------
     source : Model, FitResult or mapping
         A model (``rb.model``), a fit (``rb.fit``), or ``{channel: model}``
-        (:func:`roughbrdf.fitting.results.result.fitted_models` reads one from a fit's folder).
+        (:func:`roughbrdf.fitting.results.fit_json.fitted_models` reads one from a fit's folder).
     out : str or path-like
         The file (``.bsdf``, ``.json`` or ``.xml`` added without a suffix). A fit whose
         channels are not one BSDF gives one file per channel, ``<stem>_<channel><suffix>``

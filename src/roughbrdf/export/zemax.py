@@ -263,7 +263,7 @@ def _models(obj: Any, channel: Any) -> list[tuple[str | None, Model]]:
             raise ArgumentError("channel", "applies to a fit; a model is one file", value=channel)
         return [(None, obj)]
     if isinstance(obj, Mapping) and obj and all(isinstance(m, Model) for m in obj.values()):
-        # {channel: model}, e.g. roughbrdf.fitting.results.result.fitted_models(fit folder)
+        # {channel: model}, e.g. roughbrdf.fitting.results.fit_json.fitted_models(fit folder)
         if channel is None:
             return [(str(k), m) for k, m in obj.items()]
         key = channel if channel in obj else list(obj)[int(channel)] \
@@ -323,9 +323,9 @@ def to_zemax(model_or_fit: Any, out: str | os.PathLike, *, angles_of_incidence: 
     Parameters
     ----------
     model_or_fit : Model, FitResult or mapping
-        A fit (or ``{channel: model}``, e.g. :func:`roughbrdf.fitting.results.result.fitted_models`
-        of
-        a saved fit) writes one file per channel, ``<stem>_<channel>.bsdf`` beside ``out``.
+        A fit (or ``{channel: model}``, e.g.
+        :func:`roughbrdf.fitting.results.fit_json.fitted_models` of a saved fit) writes one
+        file per channel, ``<stem>_<channel>.bsdf`` beside ``out``.
     out : str or path-like
         The file (``.bsdf`` added when it has no suffix).
     angles_of_incidence, radial, azimuth : array_like, optional

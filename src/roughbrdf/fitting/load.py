@@ -51,7 +51,8 @@ from ..instrument import Aperture
 from .energy import EnergyConstraint
 from .problem.data import Comparison, DataOptions, prepare_channel
 from .problem.objective import Objective, ObjectiveSpec
-from .results.result import MAX_FIT_JSON_BYTES, ChannelFit, FitResult, channel_model, read_fit_json
+from .results.fit_json import MAX_FIT_JSON_BYTES, channel_model, read_fit_json
+from .results.result import ChannelFit, FitResult
 
 if TYPE_CHECKING:
     from ..measurement import Measurement
@@ -167,7 +168,7 @@ def _refuse_other_kinds(path: Path, content: dict[str, Any] | None = None) -> No
     if isinstance(opts, dict) and opts.get("mueller") is not None:
         raise ValueError(
             f"{path}: a Mueller-matrix fit, which load_fit does not rebuild; its fitted model "
-            f"is roughbrdf.fitting.results.result.fitted_models({str(path.parent)!r})")
+            f"is roughbrdf.fitting.results.fit_json.fitted_models({str(path.parent)!r})")
 
 
 def _options(content: dict[str, Any]) -> dict[str, Any]:

@@ -189,7 +189,7 @@ def _models_of(source: Any, channel: Any) -> tuple[dict[str, Model], str]:
         return {"": source}, "model"
     if isinstance(source, Mapping) and source and all(isinstance(m, Model)
                                                       for m in source.values()):
-        # {channel: model}, e.g. roughbrdf.fitting.results.result.fitted_models(fit folder)
+        # {channel: model}, e.g. roughbrdf.fitting.results.fit_json.fitted_models(fit folder)
         models = {str(k): m for k, m in source.items()}
         if channel is None:
             return models, ("channel" if len(models) == 1 else "multi")
@@ -270,7 +270,7 @@ def export_mitsuba(source: Any, *, channel: int | str | None = None, rgb: Any = 
     ----------
     source : Model, FitResult or mapping
         A model (sums allowed), a fit (its fitted models), or ``{channel: model}`` (e.g.
-        :func:`roughbrdf.fitting.results.result.fitted_models` of a saved fit).
+        :func:`roughbrdf.fitting.results.fit_json.fitted_models` of a saved fit).
     channel : int or str, optional
         One channel of a fit (label or position).
     rgb : None, False or (red, green, blue)

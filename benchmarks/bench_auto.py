@@ -11,7 +11,10 @@ add); and in the same run the
 references that show what each part costs -- without the cross-validation (``cv=False``), without
 the energy constraint -- and one ``coated`` fit; with the CPU, its widest vector unit
 (``avx512f``/``avx2`` in ``/proc/cpuinfo``) and the load average before and after, since a
-loaded 2-core machine can double every figure. Needs ``../shared/data`` (or
+loaded 2-core machine can double every figure. Then where one ``rb.fit("auto")`` spends its
+time (:func:`breakdown`: per candidate and stage, seconds, model evaluations, units of one
+coated fit), and each shared paint's ``--model auto`` beside one coated fit and beside the
+whole comparison it replaced (:func:`per_file`). Needs ``../shared/data`` (or
 ``ROUGHBRDF_SHARED_DATA``); prints a note and returns without it.
 """
 
@@ -37,6 +40,8 @@ from machine import cpu_name, load, vector_width  # noqa: E402
 HERE = Path(__file__).resolve().parent
 DATA = Path(os.environ.get("ROUGHBRDF_SHARED_DATA", HERE.parent.parent / "shared" / "data"))
 FILE = "C2_Black"
+#: the shared paints (``per_file``)
+PAINTS = ("C2_Black", "C8_Silver", "C12_OliveDrab")
 REPEAT = 2
 #: ``AUTO_CANDIDATES`` before the metallic-paint candidates (2026-12-06)
 BEFORE_METALLIC = ("trowbridge-reitz-1975", "coated", "coated(lobes=2)",
@@ -148,7 +153,28 @@ def main() -> None:
     for label, t in times.items():
         print(f"| {label} | {t:.2f} | {t / coated:.1f}x |", flush=True)
     breakdown(meas, coated)
+    per_file()
     print(f"\nload average after: {load()}")
+
+
+def per_file() -> None:
+    """``--model auto`` on each shared paint and its ratio to one coated fit of the same file,
+    beside the whole comparison (``rb.compare`` of the same candidates, every one fitted
+    whole and scored: what ``--model auto`` cost before its two stages), one run."""
+    print("\nEach shared paint (auto and coated: best of "
+          f"{REPEAT}; the whole comparison: one run)\n")
+    print("| file | one coated fit (s) | rb.fit('auto') (s) | ratio | whole comparison (s) "
+          "| ratio | kept (auto / whole) |\n|---|---|---|---|---|---|---|")
+    for paint in PAINTS:
+        meas = rb.read(DATA / "minidiff" / f"{paint}.astm")
+        kept = rb.fit("auto", meas, progress=False).model_name  # warm: this file's tables
+        coated = best(lambda m=meas: rb.fit("coated", m, progress=False))
+        auto = best(lambda m=meas: rb.fit("auto", m, progress=False))
+        t0 = time.perf_counter()
+        whole = rb.compare(meas, progress=False)
+        t_whole = time.perf_counter() - t0
+        print(f"| {paint} | {coated:.2f} | {auto:.2f} | {auto / coated:.1f}x | {t_whole:.2f} | "
+              f"{t_whole / coated:.1f}x | {kept} / {whole.best.label} |", flush=True)
 
 
 if __name__ == "__main__":

@@ -308,3 +308,16 @@ def test_pure_python_mode_agrees():
     ph = np.array([0.0, 1.0, math.pi, -2.0])
     np.testing.assert_allclose(pure[0], m.bridf(ti, tr, ph), rtol=1e-13)
     np.testing.assert_allclose(pure[1], m.brdf(ti, tr, ph, "s"), rtol=1e-13)
+
+
+@pytest.mark.parametrize("distribution", ["trowbridge-reitz", "beckmann"])
+@pytest.mark.parametrize("shadowing", ["smith-separable", "smith-height-correlated"])
+def test_without_a_coat_the_interface_table_is_ones(distribution, shadowing):
+    # coat=False packs a constant table of ones (models/coated_conductor.py, _pack): at n = 1
+    # the coat's Fresnel factor is exactly 0, so its lobe's albedo E is 0, R is 0 and the
+    # smooth-interface factor min(1, (1 - E)/(1 - R)) is 1 at every node, for any width
+    from roughbrdf.models.coated import smooth_interface_factors
+
+    for alpha in (0.006, 0.05, 0.3, 1.4):
+        table = smooth_interface_factors(((1.0, alpha),), 1.0, distribution, shadowing)
+        assert set(table) == {1.0}, (alpha, min(table), max(table))

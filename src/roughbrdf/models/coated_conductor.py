@@ -42,7 +42,7 @@ from numba import prange
 from .. import distributions as dist
 from .. import shadowing as shd
 from .._kernels import at, driver, jit, sincos, tuple_slice
-from ..diffuse import diffuse_through, interface_transmission, table_lerp
+from ..diffuse import ROUGH_TABLE_SIZE, diffuse_through, interface_transmission, table_lerp
 from ..fresnel import (
     check_index,
     diffuse_reflectance,
@@ -57,6 +57,8 @@ from .parameters import Parameter, nonnegative, option_flag, positive, reflectan
 
 #: index of the smooth interface's factor table s(mu) in the packed parameters
 _TABLE0 = 12
+#: the factor table without a coat (``coat=False``: ``n = 1``, ``s = 1``; ``_pack``)
+_NO_COAT_TABLE = (1.0,) * ROUGH_TABLE_SIZE
 
 
 @jit(inline=True)
@@ -251,8 +253,10 @@ class CoatedConductor(Model):
         d = dist.get(o["distribution"]).code
         # no coat: n = 1, where the coat's Fresnel is 0 (its lobe vanishes), T = 1, s = 1
         n, alpha = (v["n"], v["alpha"]) if o["coat"] else (1.0, v["alpha_m"])
+        # no coat: F = 0 at n = 1 exactly, so the lobe's albedo E = 0, R = 0 and s = 1 at every
+        # node: the table is ones (not recomputed for each alpha_m a fit tries)
         table = smooth_interface_factors(((1.0, alpha),), n, o["distribution"],
-                                         o["shadowing"])
+                                         o["shadowing"]) if o["coat"] else _NO_COAT_TABLE
         nm, km = self.flake_index()
         # no pigment: d = 0 (its term vanishes); rho = None: white pigment
         return (n, alpha, dist.normalization(d, alpha), nm, km, v["alpha_m"],

@@ -119,6 +119,30 @@ def test_a_row_with_a_non_finite_value_is_not_considered():
     assert tail is not None and tail.rows == 14 and tail.exact_rows == 9
 
 
+def test_rows_in_any_sample_order_and_only_long_rows_walked(monkeypatch):
+    # the rows are found by one sort (extrapolation._rows), not one array per row: the same
+    # tail whatever the order of the samples, and the per-row walk (_ramp_start) only for the
+    # rows that can hold a ramp -- none of 20000 one-sample rows (a MERL file: a million)
+    from roughbrdf import extrapolation
+
+    meas = _build(_like_minidiff)
+    perm = np.random.default_rng(5).permutation(meas.n_samples)
+    shuffled = find_extrapolated_tail(meas.theta_i[perm], meas.theta_r[perm], meas.phi[perm],
+                                      meas.values[perm])
+    assert shuffled == _tail(meas) and shuffled is not None and shuffled.exact_rows == 9
+    walked = []
+    real = extrapolation._ramp_start
+    monkeypatch.setattr(extrapolation, "_ramp_start",
+                        lambda tr, x: walked.append(tr.size) or real(tr, x))
+    rng = np.random.default_rng(6)
+    ti, ph = rng.uniform(0, 1.5, 20000), rng.uniform(-3, 3, 20000)
+    tr = np.full(20000, 0.5 * math.pi)  # each row a single sample at 90 deg: counted, no ramp
+    tail = find_extrapolated_tail(ti, tr, ph, np.zeros((20000, 1)))
+    assert tail is None and walked == []
+    assert find_extrapolated_tail(ti[:0], tr[:0], ph[:0], np.zeros((0, 1))) is None
+    assert _tail(meas) is not None and walked == [TR_DEG.size] * 15  # the 15 rows, whole
+
+
 @pytest.mark.parametrize("case", ["measured", "model_brdf_cos", "zeros", "all_zeros",
                                   "some_incidences", "two_starts", "near_ramp", "too_short"])
 def test_not_detected(case):

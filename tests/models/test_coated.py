@@ -776,15 +776,18 @@ def test_with_params_follows_the_options():
 # ------------------------------------------------------------------------------------------
 # NUMBA_DISABLE_JIT=1 gives the same numbers (pure Python, for debugging and coverage)
 # ------------------------------------------------------------------------------------------
-# the lobes' widths close together: in plain Python each lobe-albedo node table the widths
-# fall between takes seconds to build (diffuse._albedo_node), and these share theirs; the code
-# paths are those of any widths
+# the lobes' widths on the lobe-albedo grid's nodes (alpha = 10^(i/128), diffuse._albedo_smooth)
+# but one: in plain Python each node table takes seconds to build (diffuse._albedo_node), a
+# width on a node needs its own only, one between nodes the four around it. The spline between
+# the nodes is NumPy code, the same with the JIT on or off; the kernels' paths are those of
+# any widths
+_NODE = [10.0 ** (i / 128) for i in (-128, -127, -126)]  # 0.1, 0.1018, 0.1037
 _PURE_CASES = [
-    ("coated", {"lobes": 2, "diffuse": "oren-nayar", "sigma": 0.4, "rho": 0.7, "alpha": 0.1,
-                "alpha2": 0.11, "w2": 0.3}),
+    ("coated", {"lobes": 2, "diffuse": "oren-nayar", "sigma": 0.4, "rho": 0.7,
+                "alpha": _NODE[0], "alpha2": 0.1009, "w2": 0.3}),
     ("coated", {"distribution": "beckmann", "shadowing": "smith-height-correlated",
-                "shadow_diffuse": False, "lobes": 3, "alpha": 0.1, "alpha2": 0.105,
-                "alpha3": 0.11, "w2": 0.3, "w3": 0.2}),
+                "shadow_diffuse": False, "lobes": 3, "alpha": _NODE[0], "alpha2": _NODE[1],
+                "alpha3": _NODE[2], "w2": 0.3, "w3": 0.2}),
     ("oren-nayar", {"sigma": 0.5}),
 ]
 

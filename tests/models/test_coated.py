@@ -960,25 +960,47 @@ def test_rough_interface_arguments():
     assert t.shape == (64,) and 0 < f_int < 1 and f_int != f_int2  # the G1 differs
 
 
-def test_rough_interface_pure_python_mode_agrees():
+#: Gauss-Legendre nodes per axis of the rough interface's rules in the plain-Python check
+#: (Mitsuba's 32 and 128 take 20 s in plain Python; the check compares the two paths, which
+#: compute the same rule whatever its size)
+_PURE_RULE = {"_NODES_EXTERNAL": 8, "_NODES_INTERNAL": 16}
+
+
+def test_rough_interface_pure_python_mode_agrees(monkeypatch):
     code = textwrap.dedent("""
         import json, numpy as np, numba, roughbrdf as rb
         assert numba.config.DISABLE_JIT
+        for name, nodes in json.loads(%r).items():
+            setattr(rb.diffuse, name, nodes)
         m = rb.model("coated", alpha=0.3, rho=0.7, shadow_diffuse=False, interface="rough")
         ti = np.array([0.0, 0.3, 1.2, 1.5]); tr = np.array([0.0, 0.4, 1.2, 1.5707963267948966])
         ph = np.array([0.0, 1.0, 3.141592653589793, -2.0])
         print(json.dumps([m.brdf(ti, tr, ph).tolist(), m.bridf(ti, tr, ph, "p").tolist()]))
-    """)
+    """) % json.dumps(_PURE_RULE)
     env = dict(os.environ, NUMBA_DISABLE_JIT="1")
     res = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
                          timeout=300, check=True)
     brdf, bridf = json.loads(res.stdout.strip().splitlines()[-1])
-    m = rb.model("coated", alpha=0.3, rho=0.7, shadow_diffuse=False, interface="rough")
-    ti = np.array([0.0, 0.3, 1.2, 1.5])
-    tr = np.array([0.0, 0.4, 1.2, HALF_PI])
-    ph = np.array([0.0, 1.0, math.pi, -2.0])
-    np.testing.assert_allclose(brdf, m.brdf(ti, tr, ph), rtol=1e-13)
-    np.testing.assert_allclose(bridf, m.bridf(ti, tr, ph, "p"), rtol=1e-13)
+    for name, nodes in _PURE_RULE.items():
+        monkeypatch.setattr(rb.diffuse, name, nodes)
+    # the tables are cached per (alpha, n): none of the full rule before, none of this after
+    rb.diffuse._rough_cached.cache_clear()
+    try:
+        m = rb.model("coated", alpha=0.3, rho=0.7, shadow_diffuse=False, interface="rough")
+        ti = np.array([0.0, 0.3, 1.2, 1.5])
+        tr = np.array([0.0, 0.4, 1.2, HALF_PI])
+        ph = np.array([0.0, 1.0, math.pi, -2.0])
+        got = m.brdf(ti, tr, ph), m.bridf(ti, tr, ph, "p")
+        small = rb.diffuse.rough_interface(0.3, 1.5)[0]
+    finally:
+        monkeypatch.undo()
+        rb.diffuse._rough_cached.cache_clear()
+    np.testing.assert_allclose(brdf, got[0], rtol=1e-13)
+    np.testing.assert_allclose(bridf, got[1], rtol=1e-13)
+    # the smaller rule is a different table (so the check did use it), near Mitsuba's
+    full = rb.diffuse.rough_interface(0.3, 1.5)[0]
+    assert not np.array_equal(full, small)
+    np.testing.assert_allclose(small, full, atol=0.05)
 
 
 def test_a_sum_takes_an_option_left_at_its_default_out_of_options():

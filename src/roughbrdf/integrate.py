@@ -49,10 +49,11 @@ CACHED_SAMPLES = 1_000_000
 
 
 def _quadrature(ti_bytes: bytes, n_psi: int, n_panels: int, order: int
-                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(theta_r, phi, weight)`` of the rule (module notes) at the incidences ``ti_bytes``
-    (float64 radians, as bytes), shape ``(incidences, n_psi, n_panels * order)``; the albedo
-    is ``sum(f cos theta_r * weight)`` over the last two axes. Grids of at most
+                ) -> tuple[np.ndarray, ...]:
+    """``(theta_r, phi, sin rho, rho_max, w)`` of the rule (module notes) at the incidences
+    ``ti_bytes`` (float64 radians, as bytes), each of shape ``(incidences, n_psi, n_panels *
+    order)`` (the last two broadcast views); the albedo is ``2 pi/n_psi sum(f cos theta_r sin
+    rho rho_max w)`` over the last two axes. Grids of at most
     :data:`CACHED_SAMPLES` samples are cached (:func:`_quadrature_cached`): every fit checks
     its channels' albedo at the same ten incidences, and building the directions (``arccos``,
     ``arctan2`` of every sample) cost as much as evaluating a coated model on them."""
@@ -63,7 +64,7 @@ def _quadrature(ti_bytes: bytes, n_psi: int, n_panels: int, order: int
 
 
 def _build_quadrature(ti_bytes: bytes, n_psi: int, n_panels: int, order: int
-                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                      ) -> tuple[np.ndarray, ...]:
     """:func:`_quadrature`, built."""
     t = np.frombuffer(ti_bytes, dtype=float).reshape(-1, 1, 1)
     u, wu = _rho_panels(n_panels, order)  # fraction of rho_max
@@ -80,8 +81,8 @@ def _build_quadrature(ti_bytes: bytes, n_psi: int, n_panels: int, order: int
     wx = cr_ * sx + sr_ * tx
     wy = sr_ * ty
     wz = np.clip(cr_ * sz + sr_ * tz, 0.0, 1.0)
-    weight = sr_ * rho_max * wu[None, None, :] * (2 * math.pi / n_psi)
-    out = (np.arccos(wz), np.arctan2(wy, wx), weight)
+    out = (np.arccos(wz), np.arctan2(wy, wx), sr_, np.broadcast_to(rho_max, sr_.shape),
+           np.broadcast_to(wu[None, None, :], sr_.shape))
     for a in out:
         a.setflags(write=False)  # shared by every call (cached)
     return out
@@ -116,12 +117,15 @@ def albedo(model: Model, theta_i: ArrayLike, *, polarization=None, n_psi: int = 
         raise ArgumentError("polarization", "albedo takes one polarization for all "
                             "incidences (a name or one angle gamma)")
     shape = ti.shape
-    theta_r, phi, weight = _quadrature(ti.tobytes(), n_psi, n_panels, order)
+    theta_r, phi, sin_rho, rho_max, wu = _quadrature(ti.tobytes(), n_psi, n_panels, order)
     # the directions are built inside the hemisphere: no second validation
     g = PreparedGeometry(np.broadcast_to(ti.reshape(-1, 1, 1), theta_r.shape), theta_r, phi,
                          gamma)
     f = model.evaluate_prepared(g, "brdf_cos")
-    out = (f * weight).sum(axis=(1, 2)).reshape(shape)
+    # the products in this order, the sum, then 2 pi/n_psi: the rounding of the albedo a
+    # fit's energy constraint and its checks see does not change with the cache
+    integrand = f * sin_rho * rho_max * wu
+    out = (integrand.sum(axis=(1, 2)) * (2 * math.pi / n_psi)).reshape(shape)
     return float(out) if out.ndim == 0 else out
 
 

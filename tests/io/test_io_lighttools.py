@@ -362,6 +362,8 @@ def test_our_reader_agrees_with_the_libbsdf_transcription(path):
 # --------------------------------------------------------------------------------------------
 # writers: read back equals the model / the measurement
 # --------------------------------------------------------------------------------------------
+@pytest.mark.jit_heavy(reason="a microfacet model on the default table and its albedos: "
+                       "2.5 min each in plain Python")
 @pytest.mark.parametrize("symmetry", ["Asymmetric", "PlaneSymmetrical"])
 def test_model_written_and_read_back_equals_the_model(tmp_path, symmetry):
     model = _model()

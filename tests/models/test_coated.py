@@ -526,6 +526,8 @@ def test_energy_identity_of_the_substrate(n):
     np.testing.assert_allclose(rb.albedo(two, INCIDENCES), 1 - r, atol=1e-8)
 
 
+@pytest.mark.jit_heavy(reason="coated albedos on the default grid, 8 option sets x 3 draws and 12 "
+                       "lobes: over 5 min in plain Python")
 def test_albedo_at_most_one_for_physical_parameters():
     # rho <= 1 and lobe weights that sum to 1 (the lobes share one interface). The substrate
     # term alone never reflects more than 1 - R(theta_i) (the identity above; shadowing only

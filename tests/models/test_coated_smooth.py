@@ -43,6 +43,8 @@ def test_forward_difference_matches_the_derivative(name):
     assert np.abs(forward - central).max() < 1e-4 * np.abs(central).max()
 
 
+@pytest.mark.jit_heavy(reason="a whole coated fit (2 starts) and its albedos: over 5 min in "
+                       "plain Python")
 def test_exact_data_recovered():
     """Exact data of the limited model: ``rb.fit`` returns its parameters to 1e-7."""
     truth = rb.model("coated", **TRUTH)

@@ -984,6 +984,8 @@ def test_vanishing_width_gives_inf_not_nan():
 BULK_RETRO_OFF = ("bulk", "retro", "rho_r", "w_r", "n_r")
 
 
+@pytest.mark.jit_heavy(reason="two whole 14-parameter fits of a measured paint: over 5 min in "
+                       "plain Python")
 @pytest.mark.parametrize("name,normalization", [("C2_Black", "literal"),
                                                 ("C2_Black", "numeric"),
                                                 ("C12_OliveDrab", "literal")])

@@ -277,3 +277,22 @@ def test_resume_cleans_what_killed_workers_left(files, cluster, tmp_path):
     for name in folders:
         left = sorted(p.name for p in (out / name).iterdir() if p.name.startswith("."))
         assert left == [".roughbrdf-outputs"], (name, left)
+
+
+def test_an_interrupted_teardown_mutes_the_event_loops_loggers_and_restores_them(capsys):
+    # catalogue.run.connect: while an interrupted run is torn down, distributed's own loop
+    # callbacks can fail (a NameError in distributed.utils.sync's cancel under a loaded
+    # machine), which tornado logs with a traceback; muted then, as they were after
+    import logging
+
+    from roughbrdf.catalogue import run
+
+    log = logging.getLogger("tornado.application")
+    log.disabled = False
+    before = run._mute(run.TEARDOWN_LOGGERS)
+    assert before["tornado.application"] is False
+    log.error("Exception in callback: Traceback (most recent call last)")
+    assert "Traceback" not in capsys.readouterr().err
+    run._unmute(before)
+    assert not any(logging.getLogger(nm).disabled for nm in run.TEARDOWN_LOGGERS
+                   if not before[nm])

@@ -72,6 +72,7 @@ def connect(client: Any = None, scheduler: str | None = None,
     # (and a later Numba parallel loop raise "Cannot set NUMBA_NUM_THREADS to a different
     # value"); the caller's environment is put back once the workers are up and at the end
     saved = {k: os.environ.get(k) for k in spawn}
+    muted: dict[str, bool] = {}
     try:
         cluster = start_local(n, spawn)
         try:
@@ -79,7 +80,14 @@ def connect(client: Any = None, scheduler: str | None = None,
             _call(STARTED_HOOKS, cluster)
             with Client(cluster, security=cluster.security) as c:
                 _call(CONNECTED_HOOKS, c)
-                yield c, True
+                try:
+                    yield c, True
+                except BaseException:
+                    # an interrupted run's teardown: distributed's own loop callbacks can fail
+                    # as the loop is cut (a NameError in distributed.utils.sync's cancel, which
+                    # tornado logs with its traceback); not the user's, who is told "interrupted"
+                    muted = _mute(TEARDOWN_LOGGERS)
+                    raise
         finally:
             from ..interrupts import cleaning_up
 
@@ -87,6 +95,29 @@ def connect(client: Any = None, scheduler: str | None = None,
                 close_local(cluster)
     finally:
         _restore_environ(saved)
+        _unmute(muted)
+
+
+#: the loggers of the event loop under distributed, muted while an interrupted run is torn down
+TEARDOWN_LOGGERS = ("tornado.application", "tornado.general", "asyncio", "distributed")
+
+
+def _mute(names: tuple[str, ...]) -> dict[str, bool]:
+    """Disable the loggers ``names``; returns their previous ``disabled`` flags."""
+    import logging
+
+    before = {nm: logging.getLogger(nm).disabled for nm in names}
+    for nm in names:
+        logging.getLogger(nm).disabled = True
+    return before
+
+
+def _unmute(before: dict[str, bool]) -> None:
+    """Put back the ``disabled`` flags :func:`_mute` returned."""
+    import logging
+
+    for nm, flag in before.items():
+        logging.getLogger(nm).disabled = flag
 
 
 #: seconds a local cluster has to close before its worker processes are killed

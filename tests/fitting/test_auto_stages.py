@@ -1,5 +1,7 @@
 """``--model auto`` in two stages (``roughbrdf.fitting.choice.auto``): a candidate far behind on the
-first channel is skipped, and the candidates fitted further get the fit ``rb.compare`` makes.
+first channel is skipped, so is one whose extra parameters do not buy a prediction
+``PARSIMONY_MARGIN`` better there, and the candidates fitted further get the fit ``rb.compare``
+makes.
 
 What is protected: the choice and every kept candidate's fit are those of the whole comparison
 (the skip only saves time), a skipped candidate says so and ranks after every whole one, and
@@ -9,6 +11,7 @@ the search resumed after the first channel (``fit_model(..., done=...)``) is the
 from __future__ import annotations
 
 import json
+import re
 import sys
 
 import numpy as np
@@ -63,10 +66,49 @@ def test_the_far_candidate_is_skipped_and_says_so(both):
     assert staged.model_choice.candidates[-1] is skipped  # after every whole candidate
     assert any("lambertian: fitted to channel c0 only" in n for n in staged.model_choice.notes)
     row = json.loads(staged.to_json())["model_choice"]["candidates"]
-    assert [r["partial"] is not None for r in row] == [False, False, True]
+    # coated(lobes=2) is skipped too (the parsimony rule: next test)
+    assert [r["partial"] is not None for r in row] == [False, True, True]
     assert "lambertian (first channel only)" in staged.model_choice.table()
     # a whole candidate's BIC is not compared with one over fewer samples
     assert staged.model_choice.best_bic.partial is None
+
+
+def test_a_second_lobe_the_data_do_not_need_is_skipped_and_says_so(both):
+    whole, staged = both
+    rows = {c.label: c for c in staged.model_choice.candidates}
+    two, one = rows["coated(lobes=2)"], rows["coated"]
+    # one lobe made the data: the second lobe's two parameters cannot predict the first
+    # channel 5 % better (an identity of the truth, up to the noise)
+    assert one.partial is None and two.partial is not None
+    assert "no more than 5% better" in two.partial and "than coated with 3" in two.partial
+    assert [c.channel for c in two.result.channels] == ["c0"]
+    # the note's two first-channel scores meet the rule's condition; its own is its row's CV
+    mine, simpler = map(float, re.findall(r"\(([0-9.e+-]+)\)", two.partial))
+    assert mine >= simpler * (1 - auto.PARSIMONY_MARGIN)
+    assert mine == pytest.approx(two.cv, rel=1e-3)
+    assert staged.model_name == "coated" == whole.best.label
+
+
+def test_a_second_lobe_the_data_need_goes_on(two_lobes):
+    staged, rows = two_lobes
+    # a narrow lobe over a wide haze (weights 0.6/0.4, widths 0.05 and 0.4): one GGX lobe
+    # cannot make both, the second lobe predicts far more than 5 % better and is fitted whole
+    assert rows["coated(lobes=2)"].partial is None
+    assert staged.model_name == "coated(lobes=2)"
+    assert rows["coated(lobes=2)"].cv < rows["coated"].cv * (1 - auto.PARSIMONY_MARGIN)
+
+
+@pytest.fixture(scope="module")
+def two_lobes():
+    truth = rb.model("coated(lobes=2)", n=1.5, rho=0.3, alpha=0.05, alpha2=0.4, w2=0.4)
+    g = list(np.radians(np.mgrid[10:61:25, 0:81:4, 0:181:45].reshape(3, -1)))
+    rng = np.random.default_rng(5)
+    clean = np.stack([truth.with_values(["rho"], [0.3 + 0.2 * j]).brdf(*g)
+                      for j in range(2)], axis=1)
+    meas = rb.Measurement(*g, clean * (1 + 0.02 * rng.standard_normal(clean.shape)),
+                          channels=["c0", "c1"])
+    staged = auto.fit_auto(meas, ["coated", "coated(lobes=2)"], starts=STARTS)
+    return staged, {c.label: c for c in staged.model_choice.candidates}
 
 
 def test_the_choice_and_the_kept_fits_are_the_whole_comparisons(both):

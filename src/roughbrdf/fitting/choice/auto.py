@@ -20,12 +20,20 @@ choice"):
    fit (the same subsample draws, the first channel's optimum as the warm start: the fit is
    the one ``compare`` makes), and scored over all channels as ``compare`` scores them, the
    first channel's folds not refitted.
+3. parsimony: a candidate that goes on is still not fitted further when another that goes on
+   has fewer free parameters (on the first channel) and the candidate does not predict the
+   first channel at least :data:`PARSIMONY_MARGIN` better: its extra parameters would have to
+   buy a clearly better prediction on the whole file to win there, and on the first channel
+   they did not (its row says so and ranks after every whole candidate).
 
 Why: model choice cost 12x one ``coated`` fit, and a candidate that predicts the first channel
 3x worse than the best (TR75 on the shared paints) never won on the whole file. The margin is
 measured (``scripts/auto_margin.py``): on the three shared paints the skipped candidates'
 first-channel scores are 1.5x to 3.3x the best's, the kept ones' within 1.13x, and the choice
-is the one of the whole comparison.
+is the one of the whole comparison. The parsimony margin likewise: the two-lobe candidates
+predicted the first channel 0-3 % better than ``coated`` on the shared paints, and none of them
+won on the whole file (their whole-file scores within 1-2 % of it, or with a parameter on a
+search limit); their whole fits were half of ``--model auto``'s time.
 """
 
 from __future__ import annotations
@@ -59,12 +67,18 @@ if TYPE_CHECKING:
     from ...measurement import Measurement
     from ..results.result import FitResult
 
-__all__ = ["fit_auto", "SKIP_MARGIN"]
+__all__ = ["fit_auto", "SKIP_MARGIN", "PARSIMONY_MARGIN"]
 
 #: a candidate whose first-channel score exceeds the best first-channel score by more than this
 #: fraction is not fitted to the other channels (module notes; measured on the shared paints:
 #: the candidates that lost were 1.5x and more above the best, the closest that won 0.13 above)
 SKIP_MARGIN = 0.5
+
+#: a candidate with more free parameters than another that goes on must predict the first
+#: channel at least this fraction better than it to be fitted to the other channels (module
+#: notes; measured on the shared paints: the two-lobe candidates' gains over ``coated`` there
+#: were 0-3 %, and neither won on the whole file)
+PARSIMONY_MARGIN = 0.05
 
 
 def fit_auto(measurement: Measurement, candidates: Sequence[Model | str] | str | None = None,
@@ -137,22 +151,16 @@ def _in_two_stages(measurement: Measurement, models: list[Model], options: FitOp
         helds.append(held)
         rows.append(candidate(label, res, rms(held)))
     scores = [math.nan if h is None else rms(h) for h in helds]
-    # the margin is counted from the best candidate that can be kept: not one that gains
-    # energy or stopped on a search limit (both rank after the others, compare.rank)
-    sound = [s for s, r, lim in zip(scores, rows, limited, strict=True)
-             if not r.gains_energy and not lim]
-    pool = sound or [s for s in scores if not math.isnan(s)]
-    best = min(pool) if pool else math.nan  # NaN: no score, every candidate skipped below
+    skips = _skipped(rows, scores, limited)
     out: list[Candidate] = []
-    for m, first_row, first_held, score in zip(models, rows, helds, scores, strict=True):
+    for m, first_row, first_held, why in zip(models, rows, helds, skips, strict=True):
         label, res = first_row.label, first_row.result
         if first_held is None:  # stopped on a search limit (above)
             out.append(first_row)
             continue
-        if not score <= best * (1 + SKIP_MARGIN):  # NaN: skipped too
+        if why is not None:
             out.append(dataclasses.replace(first_row, partial=(
-                f"fitted to channel {res.channels[0].channel} only: its score there "
-                f"({score:.4g}) is more than {SKIP_MARGIN:.0%} above the best's ({best:.4g})")))
+                f"fitted to channel {res.channels[0].channel} only: {why}")))
             continue
         # the other channels, the search going on from the first as in one whole fit: the
         # same fit as compare's, and the first channel's folds are not refitted
@@ -163,3 +171,33 @@ def _in_two_stages(measurement: Measurement, models: list[Model], options: FitOp
                                                             metric=metric)])
         out.append(candidate(label, whole, rms(held_all)))
     return comparison(out, measurement, losses)
+
+
+def _skipped(rows: list[Candidate], scores: list[float], limited: list[bool]
+             ) -> list[str | None]:
+    """Why each first-channel candidate is not fitted further (None: it is): its score more
+    than :data:`SKIP_MARGIN` above the best, or not :data:`PARSIMONY_MARGIN` below that of a
+    candidate with fewer free parameters that goes on (module notes). NaN scores are skipped."""
+    # the margin is counted from the best candidate that can be kept: not one that gains
+    # energy or stopped on a search limit (both rank after the others, compare.rank)
+    sound = [not r.gains_energy and not lim for r, lim in zip(rows, limited, strict=True)]
+    pool = [s for s, ok in zip(scores, sound, strict=True) if ok]
+    pool = pool or [s for s in scores if not math.isnan(s)]
+    best = min(pool) if pool else math.nan  # NaN: no score, every candidate skipped below
+    why: list[str | None] = []
+    for score in scores:
+        within = score <= best * (1 + SKIP_MARGIN)  # NaN: False, skipped
+        why.append(None if within else (f"its score there ({score:.4g}) is more than "
+                                        f"{SKIP_MARGIN:.0%} above the best's ({best:.4g})"))
+    free = [len(r.result.channels[0].free) for r in rows]
+    for i, score in enumerate(scores):
+        if why[i] is not None:
+            continue
+        simpler = [j for j in range(len(rows)) if why[j] is None and sound[j]
+                   and free[j] < free[i] and not score < scores[j] * (1 - PARSIMONY_MARGIN)]
+        if simpler:
+            j = min(simpler, key=lambda j: scores[j])
+            why[i] = (f"with {free[i]} free parameters it predicts there no more than "
+                      f"{PARSIMONY_MARGIN:.0%} better ({score:.4g}) than {rows[j].label} "
+                      f"with {free[j]} ({scores[j]:.4g})")
+    return why

@@ -6,8 +6,8 @@ fit of the same run (the ratio travels between machines; the absolute time does 
 
 Printed, warm (the compiled kernels and the lobe-albedo tables built by a first run, not
 counted), best of :data:`REPEAT`: the default ``rb.fit("auto")``; the same with the candidates
-before the metallic ones (:data:`BEFORE_METALLIC`, issue 28: the cost the metallic candidates
-add); and in the same run the
+as it was until 2026-12-06 (:func:`as_before`: the Beckmann pair among the candidates, no
+parsimony rule); and in the same run the
 references that show what each part costs -- without the cross-validation (``cv=False``), without
 the energy constraint -- and one ``coated`` fit; with the CPU, its widest vector unit
 (``avx512f``/``avx2`` in ``/proc/cpuinfo``) and the load average before and after, since a
@@ -20,6 +20,7 @@ whole comparison it replaced (:func:`per_file`). Needs ``../shared/data`` (or
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 import time
@@ -43,9 +44,23 @@ FILE = "C2_Black"
 #: the shared paints (``per_file``)
 PAINTS = ("C2_Black", "C8_Silver", "C12_OliveDrab")
 REPEAT = 2
-#: ``AUTO_CANDIDATES`` before the metallic-paint candidates (2026-12-06)
-BEFORE_METALLIC = ("trowbridge-reitz-1975", "coated", "coated(lobes=2)",
-                   "coated(lobes=2, distribution=beckmann)")
+#: ``AUTO_CANDIDATES`` until 2026-12-06 (the Beckmann pair among them), run as then: without
+#: the parsimony rule (``PARSIMONY_MARGIN``, :func:`as_before`) -- the "before" of the figures
+BEFORE = ("trowbridge-reitz-1975", "coated", "coated(lobes=2)",
+          "coated(lobes=2, distribution=beckmann)",
+          "coated-conductor(coat=false, diffuse=true, flakes=reflectance)",
+          "coated-conductor(diffuse=true, flakes=reflectance)")
+
+
+def as_before(meas: rb.Measurement) -> Any:
+    """``--model auto`` as it was until 2026-12-06: :data:`BEFORE`, no parsimony rule (the
+    module's margin set to -inf for the call: every candidate within ``SKIP_MARGIN`` goes on)."""
+    margin = auto_module.PARSIMONY_MARGIN
+    auto_module.PARSIMONY_MARGIN = -math.inf
+    try:
+        return fit_auto(meas, BEFORE, progress=False)
+    finally:
+        auto_module.PARSIMONY_MARGIN = margin
 
 
 def best(call: Callable[[], object]) -> float:
@@ -133,8 +148,8 @@ def main() -> None:
     runs = {
         "rb.fit('auto') (defaults: CV score, energy constraint)":
             lambda: rb.fit("auto", meas, progress=False),
-        "rb.fit('auto'), the candidates before the metallic ones":
-            lambda: fit_auto(meas, BEFORE_METALLIC, progress=False),
+        "before (until 2026-12-06: the Beckmann pair a candidate, no parsimony rule)":
+            lambda: as_before(meas),
         "fit_auto(cv=False) (reference: no CV refits)":
             lambda: fit_auto(meas, cv=False, progress=False),
         "rb.fit('auto', energy_constraint=False) (reference)":
@@ -159,22 +174,27 @@ def main() -> None:
 
 def per_file() -> None:
     """``--model auto`` on each shared paint and its ratio to one coated fit of the same file,
-    beside the whole comparison (``rb.compare`` of the same candidates, every one fitted
-    whole and scored: what ``--model auto`` cost before its two stages), one run."""
+    beside the same before 2026-12-07 (:func:`as_before`) and the whole comparison
+    (``rb.compare`` of today's candidates, every one fitted whole and scored: what ``--model
+    auto`` cost before its two stages), one run."""
     print("\nEach shared paint (auto and coated: best of "
           f"{REPEAT}; the whole comparison: one run)\n")
-    print("| file | one coated fit (s) | rb.fit('auto') (s) | ratio | whole comparison (s) "
-          "| ratio | kept (auto / whole) |\n|---|---|---|---|---|---|---|")
+    print("| file | one coated fit (s) | rb.fit('auto') (s) | ratio | before (s) | ratio "
+          "| whole comparison (s) | ratio | kept (auto / before / whole) |\n"
+          "|---|---|---|---|---|---|---|---|---|")
     for paint in PAINTS:
         meas = rb.read(DATA / "minidiff" / f"{paint}.astm")
         kept = rb.fit("auto", meas, progress=False).model_name  # warm: this file's tables
+        kept_before = as_before(meas).model_name
         coated = best(lambda m=meas: rb.fit("coated", m, progress=False))
         auto = best(lambda m=meas: rb.fit("auto", m, progress=False))
+        before = best(lambda m=meas: as_before(m))
         t0 = time.perf_counter()
         whole = rb.compare(meas, progress=False)
         t_whole = time.perf_counter() - t0
-        print(f"| {paint} | {coated:.2f} | {auto:.2f} | {auto / coated:.1f}x | {t_whole:.2f} | "
-              f"{t_whole / coated:.1f}x | {kept} / {whole.best.label} |", flush=True)
+        print(f"| {paint} | {coated:.2f} | {auto:.2f} | {auto / coated:.1f}x | {before:.2f} | "
+              f"{before / coated:.1f}x | {t_whole:.2f} | {t_whole / coated:.1f}x | {kept} / "
+              f"{kept_before} / {whole.best.label} |", flush=True)
 
 
 if __name__ == "__main__":

@@ -239,3 +239,42 @@ def test_rb08_paint_polish_reaches_the_bound_trf_crept_towards(shared_data):
     lo, hi = ch.bounds["n_eff"]
     assert ch.params["n_eff"] == hi or hi - ch.params["n_eff"] > 0.01 * (hi - lo)
     assert ch.nfev < 15000
+
+
+def test_snap_tries_a_neutral_value_only_where_the_cost_allows_and_no_bound_is_nearer():
+    """``stationary.snap`` with neutral values (``Parameter.neutral``, TR75's ``n = 1``): an end
+    on a quartic valley around it moves onto it (the cost rises by ~1e-24, far below
+    ``SNAP_COST``); a determined parameter as near it does not (its minimum 2e-3 away: the
+    value costs 4e-6 of the cost more, above ``SNAP_COST``); an end farther than ``SNAP_DIST``
+    of its box is not tried; an end nearer a bound is left to the bound."""
+    from roughbrdf.fitting.solvers.stationary import SNAP_COST, SNAP_DIST, snap
+
+    lo, hi, pts = np.zeros(1), np.full(1, 2.0), np.array([1.0])
+    quartic = lambda x: float(1.0 + (x[0] - 1.0) ** 4)  # noqa: E731
+    x, c, n = snap(np.array([1.0 + 1e-6]), quartic(np.array([1.0 + 1e-6])), lo, hi, quartic,
+                   points=pts)
+    assert x[0] == 1.0 and n == 1
+    # determined elsewhere: the minimum at 1.002, the cost at 1 is 4e-6 above (> SNAP_COST)
+    quad = lambda x: float(1.0 + (x[0] - 1.002) ** 2)  # noqa: E731
+    assert 4e-6 > SNAP_COST
+    x, c, n = snap(np.array([1.002]), quad(np.array([1.002])), lo, hi, quad, points=pts)
+    assert x[0] == 1.002 and n == 1
+    # farther than SNAP_DIST of the box (width 2): not tried
+    far = 1.0 + 2.0 * SNAP_DIST * 1.5
+    assert snap(np.array([far]), quartic(np.array([far])), lo, hi, quartic, points=pts)[2] == 0
+    # a neutral value next to a bound: the bound settles the end (tried on 0.0, not 0.001)
+    x, _, _ = snap(np.array([1e-9]), 1.0, lo, hi, lambda x: 1.0, points=np.array([0.001]))
+    assert x[0] == 0.0
+
+
+def test_tr75_declares_n_1_its_neutral_value_inside_the_search_box():
+    """TR75's ``n = 1`` (with ``k = 0``: F = 0, Fresnel's Eq. with the index matched) is where
+    its lobe vanishes: the fit's objective offers it to ``snap``; a box that excludes it, none."""
+    from roughbrdf.fitting.problem.objective import ObjectiveSpec
+
+    m = rb.model("tr75", k=0.0)
+    assert float(np.max(m.with_params(n=1.0, rho_L=0.0).brdf(*np.radians([[30.0], [30.0],
+                                                                          [180.0]])))) == 0.0
+    spec = ObjectiveSpec(m, ["e", "n", "k"], [0.02, 0.2, 0.0], [3.0, 5.0, 10.0])
+    assert np.isnan(spec.snap_points()[[0, 2]]).all() and spec.snap_points()[1] == 1.0
+    assert np.isnan(ObjectiveSpec(m, ["n"], [1.2], [5.0]).snap_points()).all()

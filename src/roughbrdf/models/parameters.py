@@ -57,6 +57,11 @@ class Parameter:
     kind : str
         ``"reflectance"`` for the directional-hemispherical reflectance of a part of the model
         (domain :data:`REFLECTANCE_DOMAIN`, see the module notes), else ``""``.
+    neutral : float or None
+        A value inside the search range where the parameter's part of the model can vanish
+        (TR75's ``n = 1`` with ``k = 0``: the index matched, no Fresnel reflection): a fit's
+        end near it is tried on it (:func:`~roughbrdf.fitting.solvers.stationary.snap`), as an
+        end near a bound is. None: no such value.
     """
 
     name: str
@@ -67,6 +72,7 @@ class Parameter:
     domain: tuple[float, bool, float, bool] = (-math.inf, False, math.inf, False)
     optional: bool = False
     kind: str = ""
+    neutral: float | None = None
 
     def check(self, value: Any) -> float | None:
         """Validate ``value`` against the domain; return it as float (or None).

@@ -120,7 +120,9 @@ class TrowbridgeReitz1975(Model):
     reference = "Trowbridge & Reitz, JOSA 65, 531 (1975)"
     PARAMETERS = (
         positive("e", 0.68, (0.02, 3.0), "1", "ellipsoid axis ratio (GGX alpha = e)"),
-        positive("n", 1.0, (0.2, 5.0), "1", "refractive index (n + ik)"),
+        # n = 1 with k = 0 matches the index: F = 0, the specular lobe off (a fit's end
+        # there is tried on it exactly: Parameter.neutral)
+        positive("n", 1.0, (0.2, 5.0), "1", "refractive index (n + ik)", neutral=1.0),
         nonnegative("k", 0.9, (0.0, 10.0), "1", "extinction index (n + ik), >= 0 absorbing"),
         reflectance("rho_L", 0.33, "Lambertian directional-hemispherical reflectance"),
     )

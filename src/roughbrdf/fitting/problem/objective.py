@@ -136,6 +136,26 @@ class ObjectiveSpec:
                                     and abs(b - e) <= 1e-9 * max(1.0, abs(e)))
         return out
 
+    def snap_points(self) -> np.ndarray:
+        """Each free parameter's neutral value (:attr:`Parameter.neutral
+        <roughbrdf.models.parameters.Parameter.neutral>`: where its part of the model can
+        vanish, TR75's ``n = 1``), NaN for none or outside its bounds: where
+        :func:`~roughbrdf.fitting.solvers.stationary.snap` tries an end near it.
+
+        Examples
+        --------
+        >>> import roughbrdf as rb
+        >>> ObjectiveSpec(rb.model("tr75"), ["e", "n"], [0.02, 0.2], [3.0, 5.0]).snap_points()
+        array([nan,  1.])
+        """
+        by_name = {p.name: p for p in self.model.parameters}
+        out = np.full(len(self.free), np.nan)
+        for j, nm in enumerate(self.free):
+            v = getattr(by_name.get(nm), "neutral", None)
+            if v is not None and self.lower[j] < v < self.upper[j]:
+                out[j] = v
+        return out
+
     def canonical(self, theta: np.ndarray) -> np.ndarray:
         """``theta`` or, for a model with a label symmetry (two lobes that may trade places:
         :meth:`~roughbrdf.models.coated.Coated.lobe_mirror`), its mirror when that puts the

@@ -29,6 +29,13 @@ the solvers (:mod:`.bounded`, :mod:`.constrained`) do about each:
   any distance: two lobes of one width are one lobe, and the second one's weight is then any
   value in its box at one cost (C2_Black's two GGX lobes at 525 nm ended with ``w2 = 0`` in
   one run and ``w2 = 0.03``, ``alpha2 = alpha`` in another); on the edge, the end is one.
+* **An end near a neutral value inside the box** (TR75's ``n = 1`` with ``k = 0``: the index
+  matched, the specular lobe off; :attr:`Parameter.neutral
+  <roughbrdf.models.parameters.Parameter.neutral>`). The residuals are quadratic in ``n - 1``
+  there, so the solver stops where its tolerance does, on either side of 1: perturbed copies
+  of one constrained TR75 fit ended at ``n - 1`` from ``-9e-6`` to ``+7e-6``, farther apart
+  than the standard error the covariance gave. :func:`snap` tries such an end on the value
+  with the bound's rule.
 """
 
 from __future__ import annotations
@@ -39,7 +46,7 @@ from typing import Any
 import numpy as np
 
 __all__ = ["DAMP_FLOOR", "FLAT", "GTOL", "SNAP_COST", "SNAP_DIST", "edges_of", "flat", "optimality",
-           "scaling", "snap", "widths"]
+           "points_of", "scaling", "snap", "widths"]
 
 #: first-order optimality: the projected gradient's largest cosine with a scaled Jacobian
 #: column (forward differences give gradients to ~1e-8 relative: a margin of 100 above them)
@@ -142,6 +149,14 @@ def optimality(jac: np.ndarray, f: np.ndarray, x: np.ndarray, lower: np.ndarray,
     return float(np.max(np.abs(grad[keep]) / (np.sqrt(d2[keep]) * norm)))
 
 
+def points_of(spec: Any) -> np.ndarray | None:
+    """``spec.snap_points()`` (the neutral values, TR75's ``n = 1``:
+    :meth:`~roughbrdf.fitting.problem.objective.ObjectiveSpec.snap_points`) where the solver's
+    objective has it, else None."""
+    method = getattr(spec, "snap_points", None)
+    return None if method is None else np.asarray(method(), dtype=float)
+
+
 def edges_of(spec: Any) -> np.ndarray | None:
     """``spec.snap_edges()`` (:meth:`~roughbrdf.fitting.problem.objective.ObjectiveSpec.snap_edges`)
     where the solver's objective has it, else None (a duck-typed objective with bounds only:
@@ -151,13 +166,15 @@ def edges_of(spec: Any) -> np.ndarray | None:
 
 
 def snap(x: np.ndarray, cost: float, lower: np.ndarray, upper: np.ndarray,
-         trial: Callable[[np.ndarray], float | None], edges: np.ndarray | None = None
-         ) -> tuple[np.ndarray, float, int]:
+         trial: Callable[[np.ndarray], float | None], edges: np.ndarray | None = None,
+         points: np.ndarray | None = None) -> tuple[np.ndarray, float, int]:
     """Each parameter within :data:`SNAP_DIST` of its box of a bound (and of the bound itself,
     but for a bound 0), or at any distance of a bound that ``edges`` (shape ``(p, 2)``: lower,
     upper) marks as a physical edge, in order, tried on the bound: kept when ``trial(x_new)``
     (the cost there, None when the point is refused, e.g. infeasible) is at most
-    ``(1 + SNAP_COST) cost``. Returns the point, its cost and the trials made.
+    ``(1 + SNAP_COST) cost``. A parameter on no bound is then tried likewise on its neutral
+    value ``points[j]`` (NaN: none) when within :data:`SNAP_DIST` of its box of it (module
+    notes: TR75's ``n -> 1``). Returns the point, its cost and the trials made.
 
     Examples
     --------
@@ -170,11 +187,23 @@ def snap(x: np.ndarray, cost: float, lower: np.ndarray, upper: np.ndarray,
     >>> snap(np.array([0.3, 0.499]), 1.000001, np.zeros(2), np.ones(2), flat,
     ...      np.array([[False, True], [False, False]]))[0].tolist()
     [1.0, 0.499]
+    >>> quartic = lambda x: float(1.0 + (x[0] - 0.5) ** 4)  # flat at its neutral value 0.5
+    >>> snap(np.array([0.5003, 0.2]), quartic(np.array([0.5003])), np.zeros(2), np.ones(2),
+    ...      quartic, points=np.array([0.5, np.nan]))[0].tolist()
+    [0.5, 0.2]
     """
     x = np.array(x, dtype=float)
     w = widths(x, lower, upper)
     n = 0
     for j in range(x.size):
+        if points is not None and _on_point(x, j, points[j], w[j], lower[j], upper[j]):
+            x_new = x.copy()
+            x_new[j] = points[j]
+            c = trial(x_new)
+            n += 1
+            if c is not None and c <= cost + SNAP_COST * abs(cost):
+                x, cost = x_new, c
+                continue  # on its neutral value: no bound is near (_on_point)
         for side, b in enumerate((lower[j], upper[j])):
             # near: within SNAP_DIST of the box, and of the bound itself unless it is 0 (a
             # bound far below the box's width, 1e-4 of [1e-4, 1], is a search over decades:
@@ -193,3 +222,13 @@ def snap(x: np.ndarray, cost: float, lower: np.ndarray, upper: np.ndarray,
                 x, cost = x_new, c
                 break  # on a bound: the other side is not tried
     return x, cost, n
+
+
+def _on_point(x: np.ndarray, j: int, point: float, width: float, lo: float, hi: float) -> bool:
+    """Whether ``x[j]`` is to be tried on its neutral value ``point``: one is given, ``x[j]``
+    is within :data:`SNAP_DIST` of its box of it but not on it, and no bound is nearer (an
+    end near a bound is the bound's to settle)."""
+    if not np.isfinite(point) or x[j] == point:
+        return False
+    d = abs(x[j] - point)
+    return bool(d <= SNAP_DIST * width and d < abs(x[j] - lo) and d < abs(x[j] - hi))

@@ -142,3 +142,13 @@ def test_one_channel_or_no_score_compares_every_candidate_whole():
     res = auto.fit_auto(_measurement(channels=2), CANDIDATES, starts=1, cv=False)
     assert not any(c.partial for c in res.model_choice.candidates)
     assert res.model_choice.criterion == "bic"
+
+
+def test_the_cli_help_names_the_default_candidates():
+    """``--models``' help text lists ``AUTO_CANDIDATES`` as they are (it was left naming the
+    Beckmann pair and not the metallic candidates)."""
+    from roughbrdf.cli.options import ModelsOption
+    from roughbrdf.fitting.choice.compare import AUTO_CANDIDATES
+
+    text = ModelsOption.__metadata__[0].help
+    assert text.endswith("(default: " + ", ".join(AUTO_CANDIDATES) + ")")

@@ -39,7 +39,8 @@ __all__ = ["TABLE", "ModelInput", "OptionError", "ReadInput", "channel_labels",
 ModelsOption = Annotated[str | None, typer.Option(
     "--models", metavar="SPEC,SPEC,...",
     help="with --model auto: the candidates (default: trowbridge-reitz-1975, coated, "
-         "coated(lobes=2), coated(lobes=2, distribution=beckmann))")]
+         "coated(lobes=2), coated-conductor(coat=false, diffuse=true, flakes=reflectance), "
+         "coated-conductor(diffuse=true, flakes=reflectance))")]
 CvOption = Annotated[bool, typer.Option(
     "--cv/--no-cv", help="leave-one-incidence-out cross-validation score (model choice)")]
 JointOption = Annotated[bool, typer.Option(

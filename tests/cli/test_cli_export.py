@@ -63,7 +63,7 @@ def test_a_saved_fit_gives_one_zemax_file_per_channel(fit_dir, tmp_path):
     res = _run("export", "--fit", fit_dir, "--to", "zemax", "--out", tmp_path / "p.bsdf",
                "--incidences", "20")
     assert res.exit_code == 0, res.output
-    models = rb.fitting.results.result.fitted_models(fit_dir)
+    models = rb.fitting.results.fit_json.fitted_models(fit_dir)
     for label in ("525nm", "630nm"):
         m = rb.read(tmp_path / f"p_{label}.bsdf")
         want = models[label].brdf(m.theta_i, m.theta_r, m.phi)

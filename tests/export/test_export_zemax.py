@@ -174,7 +174,7 @@ def test_domain_and_argument_errors(tmp_path):
     assert f.tis[0] == pytest.approx(0.5, abs=1e-4)
     with pytest.raises(TypeError, match="Model .* a FitResult .* or a mapping"):
         to_zemax("lambertian", tmp_path / "s.bsdf")
-    # {channel: model}, as fitting.results.result.fitted_models gives it for a saved fit
+    # {channel: model}, as fitting.results.fit_json.fitted_models gives it for a saved fit
     files = to_zemax({"a": lam, "b": lam.with_params(rho=0.2)}, tmp_path / "m.bsdf")
     assert [f.path.name for f in files] == ["m_a.bsdf", "m_b.bsdf"]
     assert files[1].tis[0] == pytest.approx(0.2, abs=1e-4)

@@ -236,7 +236,7 @@ def legacy_fit_dir(tmp_path_factory):
 
 
 def test_legacy_fit_loads_with_free_weights_and_a_note(legacy_fit_dir):
-    from roughbrdf.fitting.results.result import fitted_models
+    from roughbrdf.fitting.results.fit_json import fitted_models
     from roughbrdf.models.coated import LegacyCoatedWarning
 
     with pytest.warns(LegacyCoatedWarning, match="predates energy-conserving coated lobes"):

@@ -190,9 +190,7 @@ class ChannelFit:
             cov = Covariance.at_optimum(obj, theta, f, k, chi2=gof.chi2, dof=gof.dof,
                                         held=[*bound, *none], jac=jac)
         else:
-            names = [*spec.free, *(["scale"] if spec.free_scale else [])]
-            cov = Covariance(np.full((len(names), len(names)), np.nan), names,
-                             "; no covariance (a cross-validation fold)")
+            cov = Covariance.unestimated(spec, "; no covariance (a cross-validation fold)")
         sd = cov.stderr()
         stderr: dict[str, float | None] = dict.fromkeys(spec.model.param_names)
         stderr.update({nm: float(s) for nm, s in zip(cov.names, sd, strict=True) if nm != "scale"})

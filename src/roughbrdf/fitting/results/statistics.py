@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
-    from ..problem.objective import Objective
+    from ..problem.objective import Objective, ObjectiveSpec
 
 __all__ = ["AT_BOUND_RTOL", "Covariance", "GoodnessOfFit", "at_bound", "bound_and_undetermined",
            "limit_kinds", "rms_log", "tr75_sigma"]
@@ -285,6 +285,24 @@ class Covariance:
         full = np.full((len(names), len(names)), np.nan)
         full[np.ix_(keep, keep)] = inner.matrix
         return cls(full, names, inner.note)
+
+    @classmethod
+    def unestimated(cls, spec: ObjectiveSpec, note: str) -> Covariance:
+        """A covariance of NaN over ``spec``'s fitted names (its free parameters, then
+        ``"scale"`` when free), as :meth:`at_optimum` orders them, with ``note``: none was
+        estimated (a cross-validation fold's fit only predicts).
+
+        Examples
+        --------
+        >>> import roughbrdf as rb
+        >>> from roughbrdf.fitting.problem.objective import ObjectiveSpec
+        >>> c = Covariance.unestimated(ObjectiveSpec(rb.model("lambertian"), ["rho"], [0.0],
+        ...                                          [1.0], free_scale=True), "; none")
+        >>> c.names, bool(np.isnan(c.matrix).all())
+        (['rho', 'scale'], True)
+        """
+        names = [*spec.free, *(["scale"] if spec.free_scale else [])]
+        return cls(np.full((len(names), len(names)), np.nan), names, note)
 
     def stderr(self) -> np.ndarray:
         """``sqrt(diag(covar))`` (NaN where not estimable)."""

@@ -77,8 +77,9 @@ for paint in paints:
         for c in cand.result:
             out[paint][f"{cand.label}|{c.channel}"] = {
                 "success": bool(c.success), "at_bound": dict(c.at_bound),
-                "params": {k: float(v) for k, v in c.params.items()},
-                "stderr": {k: float(v) for k, v in c.stderr.items()},
+                "params": {k: float(v) for k, v in c.params.items() if v is not None},
+                "stderr": {k: math.nan if v is None else float(v)
+                           for k, v in c.stderr.items()},
                 "constrained": bool(c.energy_constraint is not None
                                     and c.energy_constraint.active)}
 print(json.dumps(out))
@@ -99,8 +100,10 @@ def fits_of(variant: str, data: Path) -> dict:
     with tempfile.TemporaryDirectory(prefix=f"same-answer-{variant}-") as tmp:
         perturb = PERTURB if variant == "perturbed" else 0.0
         run = subprocess.run([sys.executable, "-c", CHILD, str(data), ",".join(PAINTS),
-                              repr(perturb)], check=True, capture_output=True, text=True,
+                              repr(perturb)], capture_output=True, text=True,
                              env=environment(variant, Path(tmp) / "numba"), cwd=tmp)
+    if run.returncode:  # the child's own words (an unset parameter broke it once)
+        sys.exit(f"variant {variant} failed (exit {run.returncode}):\n{run.stderr[-3000:]}")
     return json.loads(run.stdout.strip().splitlines()[-1])
 
 

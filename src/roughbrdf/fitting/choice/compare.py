@@ -54,6 +54,7 @@ from ...models import Model, from_spec, spec_text
 from ...models.factory import split_specs
 from ...quantity import Loss
 from ..kinds.channels import fit_model
+from ..problem.lobe_starts import LOBE_OFF
 from ..problem.options import FitOptions, default_loss
 from ..results.plausibility import ENERGY_TOLERANCE
 from ..solvers.search import progress_bar
@@ -86,8 +87,6 @@ AUTO_CANDIDATES: tuple[str, ...] = (
     "coated-conductor(diffuse=true, flakes=reflectance)",
 )
 
-#: a specular lobe whose weight ends below this is switched off (not counted in ``k``)
-LOBE_OFF = 1e-3
 
 #: bands of theta_r (degrees) of the residual table: [low, high)
 THETA_R_BANDS: tuple[tuple[float, float], ...] = (

@@ -12,8 +12,9 @@ evaluation each: the lowest cost, kept at least :data:`SCREEN_DIST` of the bound
 When a channel has more than ``subsample``
 samples, the local fits explore a fixed random subsample (loose tolerance
 :data:`EXPLORE_TOL`: they only need to find the basin) and the ``polish`` best distinct end
-points are refined on all samples (:func:`polish_fit`, :data:`POLISH_TOL`); the best is the
-result.
+points are refined on all samples (:func:`polish_fit`, :data:`POLISH_TOL`); when the best has a
+lobe switched off, it is polished again with its lobes reopened at each data start's widths
+(:func:`~roughbrdf.fitting.problem.lobe_starts.reopened`); the best is the result.
 
 SciPy is imported when a search runs, not with this module.
 """
@@ -30,7 +31,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ...interrupts import held_interrupts
-from ..problem.lobe_starts import MAX_DATA_STARTS, lobe_starts
+from ..problem.lobe_starts import MAX_DATA_STARTS, lobe_starts, reopened
 from ..problem.objective import Objective, ObjectiveSpec
 from ..problem.search_options import SearchOptions
 from .bounded import bounded_lm, settle
@@ -52,8 +53,11 @@ POLISH_TOL = 1e-8
 POLISH_ROUND = 100
 #: screened starts are kept at least this far apart (max-norm, in units of the bounds)
 SCREEN_DIST = 0.15
-#: end points of the exploration closer than this (in units of the bounds) are one point
-DISTINCT_END = 1e-3
+#: end points of the exploration closer than this (in units of the bounds, every parameter)
+#: are one point. The exploring fits end at EXPLORE_TOL on a subsample: ends of one basin
+#: differ by a few 1e-3 of the box (measured on C2_Black's coated metallic candidate, where
+#: with 1e-3 two such ends took both polish slots on one machine and not on another)
+DISTINCT_END = 0.05
 #: end points whose costs differ by at most this fraction are equally good: the first (in the
 #: order of the starts) is kept, so that rounding (1e-13 of a cost between AVX2 and AVX-512
 #: kernels) cannot choose between them. Not more: the exploring fits of a small channel end
@@ -240,6 +244,16 @@ def search(full: Objective, explore: Objective, starts: list[np.ndarray],
         res = polish_fit(full, xe, options.max_nfev)
         tried.append({"x0": xe.tolist(), "x": res.x.tolist(), "cost": float(res.cost),
                       "stage": "full", "origin": "explored"})
+        polished.append(res)
+    best = polished[first_best([float(r.cost) for r in polished], POLISHED_TIE)]
+    # a lobe switched off at the best end: reopened at the data's widths and polished too
+    # (problem.lobe_starts.reopened: whether a polish from a lobe of weight 0 steps into a
+    # narrow lobe hangs on the last bits of its path); the best of all is kept
+    seeds = [s for s, o in zip(starts, origins, strict=True) if o == "data"]
+    for xr in reopened(full.spec, best.x, seeds):
+        res = polish_fit(full, xr, options.max_nfev)
+        tried.append({"x0": xr.tolist(), "x": res.x.tolist(), "cost": float(res.cost),
+                      "stage": "full", "origin": "reopened"})
         polished.append(res)
     best = polished[first_best([float(r.cost) for r in polished], POLISHED_TIE)]
     return SearchOutcome(best.x, best, tried, explore.nfev)

@@ -8,11 +8,17 @@ alpha < 45 deg), Lambert's rho, and independent brute-force quadratures.
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 import pytest
+from hypothesis_profiles import jit_disabled
 
 import roughbrdf as rb
+
+#: NUMBA_DISABLE_JIT=1 (make test-nojit): the kernels run as plain Python, 100 to 1000 times
+#: slower; test_the_cached_rule_is_the_rule integrates a cheaper model on a smaller rule there
+NOJIT = jit_disabled(os.environ)
 
 
 def ggx_white(e):
@@ -142,26 +148,37 @@ def test_the_cached_rule_is_the_rule():
     # integrate._quadrature caches grids up to CACHED_SAMPLES (every fit's plausibility check
     # integrates at the same ten incidences): the cached grid gives the albedo of the grid
     # built afresh to the last bits, a second call the same, and other incidences their own
+    # Without the JIT (plain Python: 300 s and more with the coated model) a microfacet model
+    # on a 32 x 6 x 6 rule, and for the grid above the cap a Lambertian at 4 incidences x
+    # n_psi = 1024 (1.2e6 samples): the same caching code, the same checks.
     from roughbrdf import integrate
 
-    model = rb.model("coated", n=1.5, rho=0.4, alpha=0.08)
+    if NOJIT:
+        model, rule = rb.model("microfacet", alpha=0.3, n=1.5), dict(n_psi=32, n_panels=6,
+                                                                      order=6)
+        big_model, big_theta, big_psi = rb.model("lambertian", rho=0.4), [0, 30, 60, 85], 1024
+    else:
+        model, rule = rb.model("coated", n=1.5, rho=0.4, alpha=0.08), {}
+        big_model, big_theta, big_psi = model, np.arange(0.0, 89.0, 5.0), 512
+    n_psi, n_panels, order = (rule or dict(n_psi=256, n_panels=24, order=12)).values()
     theta = np.radians([0.0, 40.0, 85.0])
     integrate._quadrature_cached.cache_clear()
-    first = rb.albedo(model, theta)
+    first = rb.albedo(model, theta, **rule)
     assert integrate._quadrature_cached.cache_info().currsize == 1
-    again = rb.albedo(model, theta)
-    theta_r, phi, sin_rho, rho_max, w = integrate._build_quadrature(theta.tobytes(), 256, 24,
-                                                                    12)
+    again = rb.albedo(model, theta, **rule)
+    theta_r, phi, sin_rho, rho_max, w = integrate._build_quadrature(theta.tobytes(), n_psi,
+                                                                    n_panels, order)
     fresh = (model.brdf(theta[:, None, None], theta_r, phi) * np.cos(theta_r) * sin_rho
-             * rho_max * w).sum(axis=(1, 2)) * (2 * math.pi / 256)
+             * rho_max * w).sum(axis=(1, 2)) * (2 * math.pi / n_psi)
     np.testing.assert_array_equal(first, again)
     np.testing.assert_allclose(first, fresh, rtol=1e-12)  # brdf*cos vs brdf_cos: rounding
-    other = rb.albedo(model, np.radians([0.0, 41.0, 85.0]))
+    other = rb.albedo(model, np.radians([0.0, 41.0, 85.0]), **rule)
     assert other[0] == first[0] and other[2] == first[2] and other[1] != first[1]
     # a grid above the cap is built each time and not kept
     integrate._quadrature_cached.cache_clear()
-    big = rb.albedo(model, np.radians(np.arange(0.0, 89.0, 5.0)), n_psi=512)
+    assert len(big_theta) * big_psi * 24 * 12 > integrate.CACHED_SAMPLES
+    big = rb.albedo(big_model, np.radians(big_theta), n_psi=big_psi)
     assert integrate._quadrature_cached.cache_info().currsize == 0
     assert np.all((big > 0) & (big < 1))
-    parts = integrate._quadrature(theta.tobytes(), 256, 24, 12)
+    parts = integrate._quadrature(theta.tobytes(), n_psi, n_panels, order)
     assert not any(a.flags.writeable for a in parts)  # shared by every call: read-only

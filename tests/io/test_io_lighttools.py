@@ -8,11 +8,13 @@ XYZ), the reader's errors with their lines, and the writers (model and measureme
 from __future__ import annotations
 
 import math
+import os
 import re
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis_profiles import jit_disabled
 
 import roughbrdf as rb
 from roughbrdf.errors import ArgumentError
@@ -55,6 +57,29 @@ def _small(tmp_path, body, header="Symmetry Asymmetric\nSpectralContent Monochro
 
 
 BLOCK = "AOI 0\nTIS 0.3\n0.1 0.1\n0.1 0.1\n"
+
+#: NUMBA_DISABLE_JIT=1 (make test-nojit): the kernels run as plain Python (rb.albedo: 10 to
+#: 50 us a sample, 74 000 samples an incidence)
+NOJIT = jit_disabled(os.environ)
+#: the incidences (degrees) of an export's energy check without the JIT (lighter_energy_check)
+NOJIT_ENERGY_INCIDENCES_DEG = (0.0, 45.0, 89.0)
+
+
+@pytest.fixture
+def lighter_energy_check(monkeypatch):
+    """Without the JIT, every export's refusal of a model that gains energy
+    (``plausibility.energy_gain``: rb.albedo at the 19 EXPORT_INCIDENCES_DEG, most of a
+    LightTools export's 60 to 90 s in plain Python) looks at
+    :data:`NOJIT_ENERGY_INCIDENCES_DEG` only: the tests using it check the file written or the
+    writer's refusals, and what they export either gains energy at every incidence or at none.
+    With the JIT nothing changes."""
+    if NOJIT:
+        from roughbrdf.fitting.results import plausibility
+
+        real = plausibility.energy_gain
+        monkeypatch.setattr(plausibility, "energy_gain",
+                            lambda model, theta_deg=NOJIT_ENERGY_INCIDENCES_DEG:
+                            real(model, theta_deg))
 
 
 # --------------------------------------------------------------------------------------------
@@ -391,7 +416,7 @@ def test_callable_model_and_options(tmp_path):
     assert np.allclose(res.tis["value"], 0.4, atol=1e-3)
 
 
-def test_writer_refuses_what_it_cannot_write(tmp_path):
+def test_writer_refuses_what_it_cannot_write(tmp_path, lighter_energy_check):
     model = rb.model("lambertian", rho=0.5)
     p = tmp_path / "x.bsdf"
     to_lighttools(model, p)
@@ -475,7 +500,8 @@ REF = _reference()
 
 
 @pytest.mark.parametrize("path", [ASYM, PLANE], ids=lambda p: p.name)
-def test_committed_reference_files_are_what_the_writer_writes(tmp_path, path):
+def test_committed_reference_files_are_what_the_writer_writes(tmp_path, path,
+                                                               lighter_energy_check):
     """The files libbsdf read are today's writer output (README.md: the calls)."""
     sym = "PlaneSymmetrical" if path == PLANE else "Asymmetric"
     az = np.arange(90, 271, 15) if path == PLANE else np.arange(0, 361, 15)
@@ -555,7 +581,7 @@ def test_libbsdf_reads_the_handwritten_file_as_we_do():
         assert m.values[k, 0][0] == pytest.approx(val, rel=1e-6)
 
 
-def test_a_fit_is_written_one_channel_a_file(tmp_path):
+def test_a_fit_is_written_one_channel_a_file(tmp_path, lighter_energy_check):
     """A fit: its only channel, or the one asked for; the channel's wavelength kept."""
     res = rb.fit(rb.model("lambertian", rho=0.3), read(XYZ))
     with pytest.raises(ArgumentError, match=r"3 channels \(X, Y, Z\).*channel="):

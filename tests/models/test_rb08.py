@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_profiles import jit_disabled
 from scipy import integrate, special
 
 import roughbrdf as rb
@@ -29,6 +30,10 @@ from roughbrdf.models.renhorn_boreman import kernel as rbk
 
 deg = np.radians
 HALF_PI = math.pi / 2
+#: NUMBA_DISABLE_JIT=1 (make test-nojit): the kernels run as plain Python (100 to 1000 times
+#: slower); the heaviest tests below check the same identities, to the same tolerances, on
+#: smaller grids there
+NOJIT = jit_disabled(os.environ)
 RETRO_SHADOWING = ("width", "amplitude")
 P_NAMES = ["rho", "w", "n", "w_a", "w_b", "gamma", "delta", "n_eff", "k_eff", "bulk", "retro",
            "rho_r", "w_r", "n_r"]
@@ -359,14 +364,14 @@ def test_fast_and_general_kernels_agree():
     assert not rb.model("rb08", n_r=17.0).uses_fast_kernel
 
 
-def minidiff_like_geometry():
-    """A Mini-Diff-like grid: 4 incidences x 91 reflection zeniths (1 deg) x 46 azimuths, in
-    the order of the files (theta_i outermost), shuffled in part so that angles also recur
-    out of order."""
-    ti, tr, ph = np.meshgrid(deg([0.0, 20.0, 40.0, 60.0]), deg(np.arange(91.0)),
-                             np.linspace(-math.pi, math.pi, 46), indexing="ij")
+def minidiff_like_geometry(n_tr=91, n_ph=46, n_again=4000):
+    """A Mini-Diff-like grid: 4 incidences x ``n_tr`` reflection zeniths (0 to 90 deg: 1 deg
+    apart by default) x ``n_ph`` azimuths, in the order of the files (theta_i outermost), its
+    first ``n_again`` samples repeated shuffled so that angles also recur out of order."""
+    ti, tr, ph = np.meshgrid(deg([0.0, 20.0, 40.0, 60.0]), deg(np.linspace(0.0, 90.0, n_tr)),
+                             np.linspace(-math.pi, math.pi, n_ph), indexing="ij")
     ti, tr, ph = ti.ravel(), tr.ravel(), ph.ravel()
-    perm = np.random.default_rng(3).permutation(4000)
+    perm = np.random.default_rng(3).permutation(n_again)
     return (np.concatenate([ti, ti[perm]]), np.concatenate([tr, tr[perm]]),
             np.concatenate([ph, ph[perm]]))
 
@@ -379,13 +384,15 @@ def test_tabulated_kernel_equals_general_kernel(opts, monkeypatch):
     # Real n (and the numeric N) run the tabulated kernel: V once per distinct angle through
     # a memo, then the vectorized loop. The reference is the general kernel, which computes V
     # per sample: the same numbers (bit for bit
-    # on the data measured; 1e-13 allows for FMA contraction).
+    # on the data measured; 1e-13 allows for FMA contraction). Without the JIT (plain Python,
+    # 77 s a case on the full grid) the same grid layout 10 deg x 45 deg apart (360 samples,
+    # 180 of them again shuffled) and 300 random directions: the same comparison.
     used = []
     run = rbk._kernels.run_driver
     monkeypatch.setattr(rbk._kernels, "run_driver",
                         lambda drive, *args: (used.append(drive), run(drive, *args))[1])
-    ti, ts, ph = minidiff_like_geometry()
-    rti, rts, rph = random_geometry(3000, seed=11)
+    ti, ts, ph = minidiff_like_geometry(10, 9, 180) if NOJIT else minidiff_like_geometry()
+    rti, rts, rph = random_geometry(300 if NOJIT else 3000, seed=11)
     for params in (FULL, dict(FULL, w_r=FULL["w"], n_r=FULL["n"]),
                    dict(FULL, w=0.05, n=49.7, w_r=1.9, n_r=0.3, rho=0.005),
                    dict(FULL, n=4.0, n_r=2.0)):
@@ -488,23 +495,35 @@ TABLE_412 = {  # theta_i -> (rho 0.1 literal, rho 0.1 effective, rho 0.3 literal
 }
 
 
+#: rb.albedo's grid for the §4.12 table: its default (73728 samples an incidence); without the
+#: JIT (117 s on the default grid) 6144 samples, which give the default grid's albedos to 4e-6
+#: on these lobes (measured), far inside the table's 3 decimals
+GRID_412 = dict(n_psi=64, n_panels=12, order=8) if NOJIT else {}
+
+
 def test_section_412_normalization_table():
     th = deg(sorted(TABLE_412))
     want = np.array([TABLE_412[k] for k in sorted(TABLE_412)])
     assert unit_sigma(0.1, "literal").brdf(0.3, 0.3, 0.0, term="bulk") == 0.0
     got = np.column_stack([
-        rb.albedo(unit_sigma(0.1, "literal"), th),
-        rb.albedo(unit_sigma(0.1, "specular-width"), th),
-        rb.albedo(unit_sigma(0.3, "literal"), th),
-        rb.albedo(unit_sigma(0.3, "specular-width"), th),
+        rb.albedo(unit_sigma(0.1, "literal"), th, **GRID_412),
+        rb.albedo(unit_sigma(0.1, "specular-width"), th, **GRID_412),
+        rb.albedo(unit_sigma(0.3, "literal"), th, **GRID_412),
+        rb.albedo(unit_sigma(0.3, "specular-width"), th, **GRID_412),
     ])
     np.testing.assert_allclose(got, want, atol=0.01)
+
+
+#: rb.albedo's grid for the numeric N: 384 x 32 panels, its own error far below 2e-4; without the
+#: JIT (90 s a case) 128 x 16 panels (6 times fewer samples), its error 4.5e-5 at most on these
+#: lobes (measured against 384 x 32: rho = 0.05 at 85 deg), still 4 times inside 2e-4
+GRID_NUMERIC = dict(n_psi=128, n_panels=16) if NOJIT else dict(n_psi=384, n_panels=32)
 
 
 @pytest.mark.parametrize("rho", [0.05, 0.3, 1.0])
 def test_numeric_normalization_integrates_to_sigma(rho):
     th = deg([0.0, 30.0, 60.0, 75.0, 85.0])
-    got = rb.albedo(unit_sigma(rho, "numeric"), th, n_psi=384, n_panels=32)
+    got = rb.albedo(unit_sigma(rho, "numeric"), th, **GRID_NUMERIC)
     np.testing.assert_allclose(got, 1.0, atol=2e-4)
 
 
@@ -593,12 +612,13 @@ def test_lobe_integral_narrow_peak_log_law():
 def test_lobe_integral_finite_over_the_bounds():
     # random lobes over the fit bounds, incidences to 89.99 deg: finite and positive, or inf
     # where the width at the peak eps = cos(theta_i) V(sin theta_i) rho underflows to 0 (the
-    # kernel's lobe is then inf at its peak too); no NaN, no overflow or invalid operation
+    # kernel's lobe is then inf at its peak too); no NaN, no overflow or invalid operation.
+    # Without the JIT the first 60 of the 300 lobes (72 s for 300 in plain Python).
     rng = np.random.default_rng(5)
     th = deg(np.concatenate([[0.0, 1e-6, 20.0, 40.0, 60.0, 85.0, 89.99],
                              rng.uniform(0.0, 89.99, 13)]))
     with np.errstate(over="raise", invalid="raise", divide="raise"):
-        for _ in range(300):
+        for _ in range(60 if NOJIT else 300):
             rho, w = np.exp(rng.uniform(np.log([0.005, 0.05]), np.log([2.0, 2.0])))
             n = float(rng.choice([0.0, rng.uniform(0.0, 50.0), 50.0]))
             i = rbm.lobe_integral(th, rho, w, n)

@@ -27,6 +27,7 @@ import textwrap
 
 import numpy as np
 import pytest
+from hypothesis_profiles import jit_disabled
 from scipy.integrate import quad
 from scipy.special import betainc
 
@@ -36,6 +37,9 @@ from roughbrdf.errors import ArgumentError
 
 HALF_PI = math.pi / 2
 RNG = np.random.default_rng(21)
+#: NUMBA_DISABLE_JIT=1 (make test-nojit): the kernels run as plain Python (100 to 1000 times
+#: slower); the TIS-against-albedo tests take fewer cases and incidences there (_tis_cases)
+NOJIT = jit_disabled(os.environ)
 
 
 def _beta_geometry(beta0x: np.ndarray, dx: np.ndarray, dy: np.ndarray):
@@ -359,19 +363,30 @@ def test_sharp_abg_tis_equals_adaptive_quadrature_at_oblique_incidence(deg):
 # ------------------------------------------------------------------------------------------
 # TIS against rb.albedo (independent quadrature in angle space)
 # ------------------------------------------------------------------------------------------
-TI_GRID = np.radians([0.0, 20.0, 45.0, 60.0, 75.0, 85.0, 89.0])
+#: the incidences of the TIS-against-albedo tests; without the JIT (plain Python: 15 s a case
+#: on all seven) normal, 60 deg and the most grazing one
+TI_GRID = np.radians([0.0, 20.0, 45.0, 60.0, 75.0, 85.0, 89.0])[[0, 3, 6] if NOJIT else
+                                                                  slice(None)]
 
 
-@pytest.mark.parametrize("B", [1e-6, 1e-4, 1e-2, 1.0])
-@pytest.mark.parametrize("g", [-1.0, 0.0, 0.5, 1.0, 1.8, 2.0, 2.5, 3.0, 4.0])
+def _tis_cases(shapes, scales):
+    """``pytest.param(shape, scale)`` of every pair (ids ``"shape-scale"``, shape outermost);
+    without the JIT one pair a shape, the scales taken in turn (every shape and every scale
+    kept: 9 of the 36 ABg cases, 7 of the 28 Harvey-Shack ones)."""
+    return [pytest.param(s, x, id=f"{s}-{x}") for i, s in enumerate(shapes)
+            for j, x in enumerate(scales) if not NOJIT or j == i % len(scales)]
+
+
+@pytest.mark.parametrize(("g", "B"), _tis_cases([-1.0, 0.0, 0.5, 1.0, 1.8, 2.0, 2.5, 3.0, 4.0],
+                                                [1e-6, 1e-4, 1e-2, 1.0]))
 def test_abg_tis_equals_albedo(B, g):
     # range: A = 1e-3, B in [1e-6, 1], g in [-1, 4], theta_i in [0, 89] deg
     m = rb.model("abg", A=1e-3, B=B, g=g)
     np.testing.assert_allclose(m.tis(TI_GRID), rb.albedo(m, TI_GRID), rtol=1e-4)
 
 
-@pytest.mark.parametrize("L", [1e-3, 1e-2, 0.1, 1.0])
-@pytest.mark.parametrize("S", [-0.3, -1.0, -1.5, -2.0, -2.5, -3.0, -4.0])
+@pytest.mark.parametrize(("S", "L"), _tis_cases([-0.3, -1.0, -1.5, -2.0, -2.5, -3.0, -4.0],
+                                                [1e-3, 1e-2, 0.1, 1.0]))
 def test_harvey_shack_tis_equals_albedo(L, S):
     # range: b0 = 1, L in [1e-3, 1], S in [-4, -0.3], theta_i in [0, 89] deg
     m = rb.model("harvey-shack", b0=1.0, L=L, S=S)

@@ -30,11 +30,16 @@ import warnings
 
 import numpy as np
 import pytest
+from hypothesis_profiles import jit_disabled
 
 import roughbrdf as rb
 from roughbrdf.errors import ArgumentError
 
 HALF_PI = math.pi / 2
+#: NUMBA_DISABLE_JIT=1 (make test-nojit): the kernels run as plain Python (100 to 1000 times
+#: slower); the identities on thousands of random geometries take a few hundred there (the
+#: same identities, the same tolerances)
+NOJIT = jit_disabled(os.environ)
 TI_MAX = float(np.nextafter(HALF_PI, 0.0))  # the coated and Oren-Nayar models need theta_i < pi/2
 
 
@@ -302,7 +307,8 @@ def test_oren_nayar_albedo_and_rho():
     graze = a_ + b_ / 2
     assert graze.max() == pytest.approx(1.01518, abs=1e-5)
     assert s[np.argmax(graze), 0] == pytest.approx(0.1985, abs=1e-3)
-    for sigma in SIGMAS:
+    # without the JIT every other sigma (0.05, 0.4, 1.2; 60 s for all five in plain Python)
+    for sigma in SIGMAS[::2] if NOJIT else SIGMAS:
         m = rb.model("oren-nayar", rho=0.6, sigma=sigma)
         alb = rb.albedo(m, np.radians([0.0, 20, 40, 60]))
         assert np.all(alb <= 0.6 + 1e-5)
@@ -427,8 +433,9 @@ def test_coated_readme_example():
 @pytest.mark.parametrize("distribution", ["trowbridge-reitz", "beckmann"])
 @pytest.mark.parametrize("shadowing", ["smith-separable", "smith-height-correlated"])
 def test_specular_part_is_the_microfacet_model(distribution, shadowing):
-    # rho = 0 leaves the lobe: ks F D G/(4 cos i cos r) with F of n + 0i (docs/models.md §8)
-    ti, tr, ph = _geometry(3000, 5, TI_MAX)
+    # rho = 0 leaves the lobe: ks F D G/(4 cos i cos r) with F of n + 0i (docs/models.md §8);
+    # 300 geometries without the JIT (Beckmann: 36 s a case with 3000 in plain Python)
+    ti, tr, ph = _geometry(300 if NOJIT else 3000, 5, TI_MAX)
     ph[:3] = [0.0, math.pi, 0.0]
     tr[:3] = [ti[0], ti[1], HALF_PI]
     for alpha, n, ks in [(0.05, 1.5, 1.0), (0.3, 2.2, 0.7), (1.2, 1.05, 3.0)]:
@@ -448,8 +455,9 @@ def test_each_lobe_is_one_microfacet_lobe():
     # the lobes share the interface n: coated(lobes=2, rho=0) = mf(alpha, ks) + mf(alpha2, ks2),
     # and with the substrate, coated(lobes=j) = coated(lobes=1) + the extra microfacet lobes
     # (the substrate is shadowed by the first lobe in both)
-    # (weights="free": the free scales add; the partition of unity is tested below)
-    ti, tr, ph = _geometry(2000, 6, TI_MAX)
+    # (weights="free": the free scales add; the partition of unity is tested below);
+    # 300 geometries without the JIT (37 s with 2000 in plain Python)
+    ti, tr, ph = _geometry(300 if NOJIT else 2000, 6, TI_MAX)
     base = {"n": 1.6, "alpha": 0.08, "ks": 0.6, "weights": "free"}
     extra = [{"alpha": 0.35, "ks": 0.3}, {"alpha": 0.9, "ks": 0.1}]
     for dist_name in ("trowbridge-reitz", "beckmann"):
@@ -854,7 +862,8 @@ def test_rough_interface_is_the_formula(distribution, lobes, diffuse, shadow_dif
     p = _random_params(rng, lobes, diffuse)
     m = rb.model("coated", distribution=distribution, lobes=lobes, diffuse=diffuse,
                  shadow_diffuse=shadow_diffuse, interface="rough", **p)
-    ti, tr, ph = _geometry(4000, 32)
+    # 400 geometries without the JIT (Beckmann, 2 lobes: 112 s with 4000 in plain Python)
+    ti, tr, ph = _geometry(400 if NOJIT else 4000, 32)
     for pol in (None, "s"):
         lobes_only = coated_numpy(ti, tr, ph, {**p, "rho": 0.0}, distribution=distribution,
                                   lobes=lobes, polarization=pol)
@@ -948,7 +957,22 @@ def test_erfinv_of_the_beckmann_sampling():
     assert _erfinv(1.0) == math.inf and _erfinv(-1.0) == -math.inf
 
 
-def test_rough_interface_arguments():
+@pytest.fixture
+def small_rough_rules(monkeypatch):
+    """Without the JIT, the rough interface's rules of :data:`_PURE_RULE` (Mitsuba's 32 and 128
+    nodes a table take 30 s for Beckmann in plain Python), its cache emptied before and after
+    (no table of these rules is left for another test); with the JIT nothing changes."""
+    if NOJIT:
+        for name, nodes in _PURE_RULE.items():
+            monkeypatch.setattr(rb.diffuse, name, nodes)
+        rb.diffuse._rough_cached.cache_clear()
+        yield
+        rb.diffuse._rough_cached.cache_clear()
+    else:
+        yield
+
+
+def test_rough_interface_arguments(small_rough_rules):
     with pytest.raises(ValueError, match="distribution"):
         rb.diffuse.rough_interface(0.3, 1.5, "gaussian-angle")
     with pytest.raises(ValueError, match="alpha"):

@@ -39,7 +39,7 @@ import numpy as np
 
 from ...interrupts import held_interrupts
 from ..problem.objective import Objective
-from .stationary import GTOL, edges_of, flat, optimality, points_of, scaling, snap
+from .stationary import GTOL, flat, optimality, scaling, snap_spec
 
 __all__ = ["BoundedResult", "GaussNewtonModel", "bounded_lm", "bounded_step", "settle"]
 
@@ -209,8 +209,7 @@ def _settled(obj: Objective, x: np.ndarray, cost: float, status: int, message: s
              nfev: int, njev: int) -> BoundedResult:
     """The result at ``x``, its parameters near a bound tried on it first
     (:func:`~roughbrdf.fitting.solvers.stationary.snap`)."""
-    x, cost, n = snap(x, cost, obj.spec.lower, obj.spec.upper, _cost_of(obj),
-                      edges_of(obj.spec), points_of(obj.spec))
+    x, cost, n = snap_spec(x, cost, obj.spec, _cost_of(obj))
     return BoundedResult(x, cost, status, message, nfev + n, njev)
 
 
@@ -238,8 +237,8 @@ def settle(obj: Objective, res: Any) -> Any:
     >>> float(settle(Objective(spec, data), res).x[0])        # rho = 0 fits the zeros
     0.0
     """
-    x, cost, n = snap(np.asarray(res.x, dtype=float), float(res.cost), obj.spec.lower,
-                      obj.spec.upper, _cost_of(obj), edges_of(obj.spec), points_of(obj.spec))
+    x, cost, n = snap_spec(np.asarray(res.x, dtype=float), float(res.cost), obj.spec,
+                           _cost_of(obj))
     if n == 0 or np.array_equal(x, res.x):
         return res
     if isinstance(res, BoundedResult):

@@ -39,7 +39,7 @@ import numpy as np
 from ...interrupts import held_interrupts
 from ..problem.objective import Objective
 from .bounded import LAMBDA_MAX, BoundedResult, GaussNewtonModel
-from .stationary import GTOL, edges_of, flat, optimality, points_of, scaling, snap
+from .stationary import GTOL, flat, optimality, scaling, snap_spec
 
 __all__ = ["BAD_LIMIT", "FEASIBLE", "Limits", "constrained_lm", "finite_limits", "lsi_step",
            "violation"]
@@ -283,8 +283,7 @@ def _settled(obj: Objective, limits: Limits, x: np.ndarray, cost: float, status:
         t = _Trial.at(obj, limits, z)
         return t.cost if violation(t.g) <= allowed and math.isfinite(t.cost) else None
 
-    x, cost, n = snap(x, cost, obj.spec.lower, obj.spec.upper, trial, edges_of(obj.spec),
-                      points_of(obj.spec))
+    x, cost, n = snap_spec(x, cost, obj.spec, trial)
     return BoundedResult(x, cost, status, message, nfev + n, njev)
 
 

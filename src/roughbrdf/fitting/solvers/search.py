@@ -250,12 +250,14 @@ def search(full: Objective, explore: Objective, starts: list[np.ndarray],
     # (problem.lobe_starts.reopened: whether a polish from a lobe of weight 0 steps into a
     # narrow lobe hangs on the last bits of its path); the best of all is kept
     seeds = [s for s, o in zip(starts, origins, strict=True) if o == "data"]
-    for xr in reopened(full.spec, best.x, seeds):
+    again = reopened(full.spec, best.x, seeds)
+    for xr in again:
         res = polish_fit(full, xr, options.max_nfev)
         tried.append({"x0": xr.tolist(), "x": res.x.tolist(), "cost": float(res.cost),
                       "stage": "full", "origin": "reopened"})
         polished.append(res)
-    best = polished[first_best([float(r.cost) for r in polished], POLISHED_TIE)]
+    if again:
+        best = polished[first_best([float(r.cost) for r in polished], POLISHED_TIE)]
     return SearchOutcome(best.x, best, tried, explore.nfev)
 
 

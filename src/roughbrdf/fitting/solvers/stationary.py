@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 __all__ = ["DAMP_FLOOR", "FLAT", "GTOL", "SNAP_COST", "SNAP_DIST", "edges_of", "flat", "optimality",
-           "points_of", "scaling", "snap", "widths"]
+           "points_of", "scaling", "snap", "snap_spec", "widths"]
 
 #: first-order optimality: the projected gradient's largest cosine with a scaled Jacobian
 #: column (forward differences give gradients to ~1e-8 relative: a margin of 100 above them)
@@ -222,6 +222,13 @@ def snap(x: np.ndarray, cost: float, lower: np.ndarray, upper: np.ndarray,
                 x, cost = x_new, c
                 break  # on a bound: the other side is not tried
     return x, cost, n
+
+
+def snap_spec(x: np.ndarray, cost: float, spec: Any,
+              trial: Callable[[np.ndarray], float | None]) -> tuple[np.ndarray, float, int]:
+    """:func:`snap` within ``spec``'s bounds, with its physical edges (:func:`edges_of`) and
+    neutral values (:func:`points_of`): what every solver's end is settled by."""
+    return snap(x, cost, spec.lower, spec.upper, trial, edges_of(spec), points_of(spec))
 
 
 def _on_point(x: np.ndarray, j: int, point: float, width: float, lo: float, hi: float) -> bool:

@@ -145,3 +145,45 @@ def test_the_cli_takes_robust_and_lists_it(tmp_path, capsys):
     assert main(["fit", str(src), "-m", "microfacet", "--loss", "soft", "--out",
                  str(tmp_path / "x")]) == 2
     assert "relative, log, absolute, robust" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("r", [0.0, 0.03, -0.1, 0.4, -2.0])
+def test_the_curvature_factor_is_the_costs_over_the_gauss_newton_one(r):
+    # rho''(r) of the cost sum(r'^2) = soft_l1(r), by central differences, over 2 r'(r)^2
+    # (the Gauss-Newton curvature of r'^2), r'(r) from the residual's own finite difference
+    h = 1e-4
+    rho2 = (soft_l1(np.array([r + h])) - 2 * soft_l1(np.array([r]))
+            + soft_l1(np.array([r - h])))[0] / h**2
+    res = Loss.ROBUST.residual(np.exp(np.array([r - h, r + h])), np.ones(2), floor=0.0)
+    gn = 2 * ((res[1] - res[0]) / (2 * h)) ** 2
+    x = np.exp(np.array([r]))
+    assert Loss.ROBUST.curvature(x, np.ones(1), 1.0, 0.0)[0] == pytest.approx(rho2 / gn,
+                                                                           rel=1e-4)
+    for loss in (Loss.LOG, Loss.RELATIVE, Loss.ABSOLUTE):
+        assert loss.curvature(x, np.ones(1), 1.0, 0.0).tolist() == [1.0]
+
+
+def test_the_robust_stderr_is_hubers_variance_of_a_location_estimate():
+    # A Lambertian fit of rho by the robust loss is an M-estimate of the location ln rho of
+    # the log data: at its optimum sum(psi(r_i)) = 0 and the cost's Hessian is exactly
+    # sum(psi'(r_i))/rho^2 (psi = r/s, psi' = 1/s^3, s = sqrt(1 + r^2/c^2)), so the sandwich
+    # is Huber's (1981, Robust Statistics, Eq. 6.2.16) with the HC1 factor N/(N - 1):
+    # var(rho) = N/(N-1) rho^2 sum(psi^2) / (sum(psi'))^2
+    g = [a.ravel() for a in np.meshgrid(np.radians([0, 30, 60]), np.radians(np.arange(0, 81, 5)),
+                                         np.radians([0, 90, 180]), indexing="ij")]
+    rng = np.random.default_rng(7)
+    x = 0.4 / np.pi * np.exp(0.08 * rng.standard_normal(g[0].size))
+    x[rng.random(x.size) < 0.1] *= 4.0                       # outliers, where psi' is small
+    (c,) = rb.fit("lambertian", rb.Measurement(*g, x), progress=False).channels
+    rho = c.params["rho"]
+    r = np.log(x) - np.log(rho / np.pi)
+    s = np.sqrt(1 + (r / C) ** 2)
+    # the optimum: the score is 0 (the Newton step left in ln rho is below 1e-4)
+    assert abs(np.sum(r / s) / np.sum(s**-3)) < 1e-4
+    n = x.size
+    want = np.sqrt(n / (n - 1) * rho**2 * np.sum((r / s) ** 2) / np.sum(s**-3) ** 2)
+    assert c.stderr["rho"] == pytest.approx(want, rel=1e-4)
+    # the Gauss-Newton bread sum(r'(r)^2) alone would give a smaller error
+    gn = np.sqrt(n / (n - 1) * rho**2 * np.sum((r / s) ** 2)
+                 / np.sum((1 + s) / (2 * s**2)) ** 2)
+    assert gn < 0.9 * want

@@ -277,6 +277,11 @@ class MuellerObjective(Objective):
             rn = np.where(np.isfinite(rn), rn, BAD_RESIDUAL)
         return np.concatenate([r00, rn.ravel()])
 
+    def curvature_of(self, f: np.ndarray, k: float) -> np.ndarray:
+        """The loss's curvature factors of ``m00``, then 1 for the normalized elements (their
+        absolute differences are plain least squares)."""
+        return np.concatenate([super().curvature_of(f[:, 0], k), np.ones(self.n - self.data.n)])
+
     def scale_column(self, f: np.ndarray, k: float) -> np.ndarray:
         """``d r / d K``: that of ``m00``; the normalized elements do not depend on ``K``."""
         return np.concatenate([super().scale_column(f[:, 0], k),

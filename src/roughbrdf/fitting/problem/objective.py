@@ -346,6 +346,13 @@ class Objective:
                          - self.residual_of(self.values(tm), k)) / d
         return out
 
+    def curvature_of(self, f: np.ndarray, k: float) -> np.ndarray:
+        """Per sample, the factor of the cost's curvature over the Gauss-Newton one at model
+        values ``f`` and scale ``k`` (:meth:`~roughbrdf.quantity.Loss.curvature`; the weights
+        scale both alike). Non-finite factors (a sample without a residual) are 1."""
+        c = self.loss.curvature(self.x, f, k, self.floor)
+        return np.where(np.isfinite(c), c, 1.0)
+
     def scale_column(self, f: np.ndarray, k: float) -> np.ndarray:
         """``d r / d K`` at fixed model values (analytic): the scale's Jacobian column."""
         col = self.loss.scale_derivative(self.x, f, k, self.floor)

@@ -5,18 +5,21 @@ and statistics").
   chi2/(N - n_varys)``, lmfit's ``aic = N ln(chi2/N) + 2 n_varys`` and ``bic = N ln(chi2/N) +
   ln(N) n_varys``, TR75's ``sigma`` (:func:`tr75_sigma`, Eq. 34) and :func:`rms_log`;
 * :class:`Covariance` -- of a channel's fit (:meth:`Covariance.at_optimum`), the
-  heteroscedasticity-consistent *sandwich* ``covar = N/(N - n_varys) (J^T J)^-1 J^T diag(r^2) J
-  (J^T J)^-1`` (White 1980, the "HC1" form), ``J`` the central-difference Jacobian of the
-  residuals ``r`` at the optimum (free parameters, plus the analytic column of the scale ``K``
-  when it is free). Why not lmfit's ``(J^T J)^-1 chi2/(N - n_varys)``: that assumes every
-  residual has the same variance, and a gonioreflectometer's do not -- its noise is
+  heteroscedasticity-consistent *sandwich* ``covar = N/(N - n_varys) H^-1 J^T diag(r^2) J H^-1``
+  (White 1980, the "HC1" form), ``J`` the central-difference Jacobian of the residuals ``r`` at
+  the optimum (free parameters, plus the analytic column of the scale ``K`` when it is free), ``H
+  = J^T diag(c) J`` the cost's curvature: ``c`` is 1 for the relative, log and absolute losses
+  (``H = J^T J``) and the soft-L1's ``rho''/r'^2`` per sample for the robust loss
+  (:meth:`roughbrdf.quantity.Loss.curvature`; an M-estimator's sandwich, Huber 1981 §6.2: with
+  ``J^T J`` the robust fits' standard errors were 1.1-1.4x too small, ``docs/fitting.md``,
+  "Coverage on the shared paints"). Why not lmfit's ``(J^T J)^-1 chi2/(N - n_varys)``: that
+  assumes every residual has the same variance, and a gonioreflectometer's do not -- its noise is
   multiplicative plus an additive floor, so in a ratio or log loss the dim samples scatter far
   more than the peak that fixes the lobe's width and weight; the classical form then inflates
-  those parameters' errors (1-sigma intervals covered the truth in 85-95 % of synthetic
-  two-lobe fits instead of 68 %; the sandwich: 60-80 %,
-  ``tests/fitting/test_fit_coverage.py``). Where the residuals are homoscedastic the two agree.
-  ``stderr = sqrt(diag(covar))``, ``correl`` is ``covar`` normalized. A singular ``J^T J``
-  gives NaN and a note for the message; joint fits
+  those parameters' errors (1-sigma intervals covered the truth in 85-95 % of synthetic two-lobe
+  fits instead of 68 %; the sandwich: 60-80 %, ``tests/fitting/test_fit_coverage.py``). Where the
+  residuals are homoscedastic the two agree. ``stderr = sqrt(diag(covar))``, ``correl`` is
+  ``covar`` normalized. A singular ``J^T J`` gives NaN and a note for the message; joint fits
   (:mod:`~roughbrdf.fitting.kinds.joint`) keep the classical form;
 * :func:`at_bound` -- the parameters at (or within :data:`AT_BOUND_RTOL` of the width of their
   bounds from) a bound. They get no standard error: the covariance describes the cost as a
@@ -239,15 +242,20 @@ class Covariance:
 
     @classmethod
     def from_jacobian(cls, jmat: np.ndarray, names: list[str], *, chi2: float,
-                      dof: int, residual: np.ndarray | None = None) -> Covariance:
+                      dof: int, residual: np.ndarray | None = None,
+                      curvature: np.ndarray | None = None) -> Covariance:
         """``(J^T J)^-1 chi2/dof`` through the SVD of ``J``, or with the ``residual`` at the
-        optimum the sandwich ``N/dof (J^T J)^-1 J^T diag(r^2) J (J^T J)^-1`` (module notes);
-        NaN (and a note) if singular."""
+        optimum the sandwich ``N/dof H^-1 J^T diag(r^2) J H^-1`` (module notes), ``H = J^T
+        diag(c) J`` with the loss's ``curvature`` factors ``c`` per sample (None: all 1, ``H =
+        J^T J``); NaN (and a note) if singular."""
         p = jmat.shape[1]
         if p == 0:
             return cls(np.empty((0, 0)), names)
         try:
-            _, s, vt = np.linalg.svd(jmat, full_matrices=False)
+            # H = (sqrt(c) J)^T (sqrt(c) J): its inverse through the SVD of the scaled rows
+            bread = jmat if curvature is None or residual is None \
+                else jmat * np.sqrt(curvature)[:, None]
+            _, s, vt = np.linalg.svd(bread, full_matrices=False)
             if not np.all(np.isfinite(s)) or s[0] == 0 or s[-1] <= s[0] * 1e-12:
                 raise np.linalg.LinAlgError("singular")
             inv = (vt.T / (s * s)) @ vt
@@ -281,7 +289,8 @@ class Covariance:
             names.append("scale")
             keep.append(len(names) - 1)
         inner = cls.from_jacobian(np.hstack(cols), [names[j] for j in keep], chi2=chi2,
-                                  dof=dof, residual=obj.residual_of(f, k))
+                                  dof=dof, residual=obj.residual_of(f, k),
+                                  curvature=obj.curvature_of(f, k))
         full = np.full((len(names), len(names)), np.nan)
         full[np.ix_(keep, keep)] = inner.matrix
         return cls(full, names, inner.note)

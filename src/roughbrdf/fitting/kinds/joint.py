@@ -151,12 +151,14 @@ class JointObjective:
         return out
 
     def covariance(self, theta: np.ndarray, held: Sequence[str]) -> Covariance:
-        """From the central-difference joint Jacobian at ``theta`` (scales at their optimum;
-        parameters in ``held``, at a bound, get NaN, as in
-        :meth:`~roughbrdf.fitting.results.statistics.Covariance.at_optimum`)."""
+        """The sandwich of a single channel's fit
+        (:meth:`~roughbrdf.fitting.results.statistics.Covariance.at_optimum`: the loss's
+        curvature in the bread, each sample's own squared residual in the meat) from the
+        central-difference joint Jacobian at ``theta``, the channels' residuals stacked (scales
+        at their optimum; parameters in ``held``, at a bound, get NaN)."""
         names = list(self.spec.free)
         keep = [j for j, nm in enumerate(names) if nm not in held]
-        blocks, chi2 = [], 0.0
+        blocks, chi2, res, curv = [], 0.0, [], []
         n_scale = len(self.objectives) if self.spec.spec.free_scale else 0
         for c, o in enumerate(self.objectives):
             idx = self.spec.index(c)
@@ -164,6 +166,8 @@ class JointObjective:
             k = o.scale(f)
             r = o.residual_of(f, k)
             chi2 += float(r @ r)
+            res.append(r)
+            curv.append(o.curvature_of(f, k))
             block = np.zeros((o.n, len(names) + n_scale))
             block[:, idx] = o.jac_central(theta[idx], k)
             if n_scale:
@@ -173,7 +177,9 @@ class JointObjective:
         all_names = names + [f"scale[{lb}]" for lb in self.spec.labels][:n_scale]
         inner = Covariance.from_jacobian(np.vstack(blocks)[:, cols],
                                          [all_names[j] for j in cols], chi2=chi2,
-                                         dof=self.n - self.spec.n_varys)
+                                         dof=self.n - self.spec.n_varys,
+                                         residual=np.concatenate(res),
+                                         curvature=np.concatenate(curv))
         full = np.full((len(all_names), len(all_names)), np.nan)
         full[np.ix_(cols, cols)] = inner.matrix
         return Covariance(full, all_names, inner.note)

@@ -20,7 +20,7 @@ and statistics").
   fits instead of 68 %; the sandwich: 60-80 %, ``tests/fitting/test_fit_coverage.py``). Where the
   residuals are homoscedastic the two agree. ``stderr = sqrt(diag(covar))``, ``correl`` is
   ``covar`` normalized. A singular ``J^T J`` gives NaN and a note for the message; joint fits
-  (:mod:`~roughbrdf.fitting.kinds.joint`) keep the classical form;
+  (:mod:`~roughbrdf.fitting.kinds.joint`) take the same sandwich over the stacked channels;
 * :func:`at_bound` -- the parameters at (or within :data:`AT_BOUND_RTOL` of the width of their
   bounds from) a bound. They get no standard error: the covariance describes the cost as a
   quadratic bowl around an interior optimum, which an active bound is not (the optimum there is

@@ -48,15 +48,34 @@ def paints(shared_data: Path) -> dict[str, rb.Measurement]:
     return {name: rb.read(shared_data / "minidiff" / f"{name}.astm") for name in MINIDIFF_PAINTS}
 
 
+#: the doctests of ``src/`` too slow without the JIT (seconds in plain Python, one process,
+#: 2026-12-07: 583 of the 820 s that all 272 doctests and README's took): marked
+#: ``jit_heavy`` under ``NUMBA_DISABLE_JIT=1`` (:func:`pytest_collection_modifyitems`), so
+#: ``make test-nojit`` deselects them; with the JIT they run in ``make test`` as any other
+NOJIT_HEAVY_DOCTESTS: dict[str, str] = {
+    "roughbrdf.fitting.choice.compare.compare": "fits every candidate (198 s)",
+    "roughbrdf.export.rgl.to_rgl": "the tensor file's NDF and tables (116 s)",
+    "roughbrdf.explore.notebook": "a fit and every figure of the explorer (103 s)",
+    "roughbrdf.export.mitsuba.exporting.to_mitsuba": "tabulates a fitted model (65 s)",
+    "roughbrdf.export.mitsuba.emulation.mitsuba_values": "tabulates a fitted model (54 s)",
+    "roughbrdf.export.mitsuba.exporting.export_mitsuba": "tabulates a fitted model (47 s)",
+}
+
+
+@pytest.hookimpl(tryfirst=True)  # before -m deselects by mark
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Under the ``"nojit"`` profile every Hypothesis test draws at most
     :data:`hypothesis_profiles.NOJIT_MAX_EXAMPLES` examples, its own ``@settings`` included
-    (the kernels run as plain Python there; tests/hypothesis_profiles.py). Other profiles
-    leave every test's own count as it is."""
+    (the kernels run as plain Python there; tests/hypothesis_profiles.py), and the doctests of
+    :data:`NOJIT_HEAVY_DOCTESTS` are marked ``jit_heavy``. Other profiles leave every test's
+    own count and marks as they are."""
     if HYPOTHESIS_PROFILE != "nojit":
         return
     cap = settings.get_profile("nojit").max_examples
     for item in items:
+        why = NOJIT_HEAVY_DOCTESTS.get(item.name) if item.nodeid.startswith("src/") else None
+        if why is not None:
+            item.add_marker(pytest.mark.jit_heavy(reason=f"doctest, plain Python: {why}"))
         fn = getattr(item, "function", None)  # a doctest or a non-Python item has none
         if fn is not None:
             hypothesis_profiles.capped(fn, cap)

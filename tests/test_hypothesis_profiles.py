@@ -126,32 +126,43 @@ def test_a_nojit_run_draws_the_same_few_examples_whatever_the_test_asks(tmp_path
     assert len(runs[0]) == hypothesis_profiles.NOJIT_MAX_EXAMPLES and runs[0] == runs[1]
 
 
-@pytest.mark.parametrize("name", sorted(__import__("conftest").NOJIT_HEAVY_DOCTESTS))
-def test_each_doctest_marked_heavy_without_the_jit_exists(name):
-    # a renamed function would leave its mark on nothing and its doctest back in test-nojit
+def _documented(name: str) -> object:
+    """The module, class or function a doctest's name names (the longest importable module,
+    then attributes)."""
     import importlib
 
     parts = name.split(".")
-    for cut in range(len(parts), 0, -1):  # the longest importable module, then attributes
+    for cut in range(len(parts), 0, -1):
         try:
             obj = importlib.import_module(".".join(parts[:cut]))
         except ImportError:
             continue
         for attr in parts[cut:]:
             obj = getattr(obj, attr)
-        break
-    assert ">>>" in (obj.__doc__ or ""), name
+        return obj
+    raise ImportError(name)
+
+
+@pytest.mark.parametrize("name", sorted(__import__("conftest").NOJIT_HEAVY_DOCTESTS))
+def test_each_doctest_marked_heavy_without_the_jit_exists(name):
+    # a renamed function would leave its mark on nothing and its doctest back in test-nojit
+    assert ">>>" in (_documented(name).__doc__ or ""), name
 
 
 def test_a_nojit_run_deselects_the_heavy_doctests():
-    # collected as make test-nojit selects: the marked doctests are the deselected ones
+    # collected as make test-nojit selects (their modules only, and a test file so that
+    # tests/conftest.py is loaded): the marked doctests are the deselected ones
+    import inspect
+
     import conftest
 
+    root = HERE.parents[1]
+    files = sorted({str(Path(inspect.getfile(_documented(nm))).relative_to(root))  # type: ignore[arg-type]
+                    for nm in conftest.NOJIT_HEAVY_DOCTESTS})
     env = dict(os.environ, NUMBA_DISABLE_JIT="1")
     env.pop("HYPOTHESIS_PROFILE", None)
-    root = HERE.parents[1]
     res = subprocess.run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider",
-                          "--collect-only", "-q", "-m", "jit_heavy", "src/roughbrdf",
+                          "--collect-only", "-q", "-m", "jit_heavy", *files,
                           "tests/test_suite_rules.py"],
                          cwd=root, env=env, capture_output=True, text=True, timeout=300)
     got = sorted(line.split("::")[-1] for line in res.stdout.splitlines()

@@ -157,7 +157,7 @@ def test_a_nojit_run_deselects_the_heavy_doctests():
     import conftest
 
     root = HERE.parents[1]
-    files = sorted({str(Path(inspect.getfile(_documented(nm))).relative_to(root))  # type: ignore[arg-type]
+    files = sorted({str(Path(inspect.getfile(_documented(nm))).relative_to(root))
                     for nm in conftest.NOJIT_HEAVY_DOCTESTS})
     env = dict(os.environ, NUMBA_DISABLE_JIT="1")
     env.pop("HYPOTHESIS_PROFILE", None)

@@ -50,7 +50,8 @@ def test_two_lobe_coated_intervals_cover_the_truth():
     for seed in SEEDS:
         with warnings.catch_warnings():
             warnings.simplefilter("error", rb.fitting.EnergyWarning)  # none may gain energy
-            res = rb.fit("coated(lobes=2)", _noisy(seed), progress=False)
+            # 4 starts: a smooth synthetic problem (the default 8 find the same optimum)
+            res = rb.fit("coated(lobes=2)", _noisy(seed), starts=4, progress=False)
         (c,) = res.channels
         assert c.success and not c.at_bound, (seed, c.message, c.at_bound)
         for nm in names:

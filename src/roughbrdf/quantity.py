@@ -217,10 +217,11 @@ class Loss(StrEnum):
 
     def curvature(self, x: np.ndarray, f: np.ndarray, k: float, floor: float) -> np.ndarray:
         """Per sample, the cost's true curvature in the residual over the Gauss-Newton one: the
-        factor ``rho''(r)/r'(r)²`` that turns ``J^T J`` (``J`` the Jacobian of the transformed
-        residuals ``r'``) into the Hessian of ``sum(rho(r))`` in an M-estimator's sandwich
-        covariance (Huber 1981, *Robust Statistics*, §6.2; the terms in the residuals' second
-        derivatives, zero in expectation at the optimum, left out as in Gauss-Newton).
+        factor ``rho''(r)/(2 r'(r)²)`` that turns ``J^T J`` (``J`` the Jacobian of the
+        transformed residuals ``r'``, ``rho = r'²``) into the Hessian of ``sum(rho(r))`` (over
+        2) in an M-estimator's sandwich covariance (Huber 1981, *Robust Statistics*, §6.2; the
+        terms in the residuals' second derivatives, zero in expectation at the optimum, left
+        out as in Gauss-Newton).
 
         1 for the ``relative``, ``log`` and ``absolute`` losses (``r' = r``). For ``robust``,
         with ``s = sqrt(1 + r²/c²)``: ``rho = 2c²(s - 1)``, ``rho'' = 2/s³`` (for the cost

@@ -217,7 +217,7 @@ class Loss(StrEnum):
 
     def curvature(self, x: np.ndarray, f: np.ndarray, k: float, floor: float) -> np.ndarray:
         """Per sample, the cost's true curvature in the residual over the Gauss-Newton one: the
-        factor ``rho''(r)/(2 r'(r)²)`` that turns ``J^T J`` (``J`` the Jacobian of the
+        factor ``rho''(r)/(2 (dr'/dr)²)`` that turns ``J^T J`` (``J`` the Jacobian of the
         transformed residuals ``r'``, ``rho = r'²``) into the Hessian of ``sum(rho(r))`` (over
         2) in an M-estimator's sandwich covariance (Huber 1981, *Robust Statistics*, §6.2; the
         terms in the residuals' second derivatives, zero in expectation at the optimum, left
@@ -225,7 +225,7 @@ class Loss(StrEnum):
 
         1 for the ``relative``, ``log`` and ``absolute`` losses (``r' = r``). For ``robust``,
         with ``s = sqrt(1 + r²/c²)``: ``rho = 2c²(s - 1)``, ``rho'' = 2/s³`` (for the cost
-        ``sum(r'²)``) and ``r'(r)² = (1 + s)/(2s²)``, so the factor is ``2/(s (1 + s))``: 1 at
+        ``sum(r'²)``) and ``(dr'/dr)² = (1 + s)/(2s²)``, so the factor is ``2/(s (1 + s))``: 1 at
         ``r = 0``, ~``2c²/r²`` far out. Without it the standard errors of a robust fit are too
         small: by 1.12x for 5 % log-normal noise (``docs/fitting.md``, "Uncertainties").
 

@@ -9,7 +9,7 @@ and statistics").
   (White 1980, the "HC1" form), ``J`` the central-difference Jacobian of the residuals ``r`` at
   the optimum (free parameters, plus the analytic column of the scale ``K`` when it is free), ``H
   = J^T diag(c) J`` the cost's curvature: ``c`` is 1 for the relative, log and absolute losses
-  (``H = J^T J``) and the soft-L1's ``rho''/(2 r'^2)`` per sample for the robust loss
+  (``H = J^T J``) and the soft-L1's ``rho''/(2 (dr'/dr)^2)`` per sample for the robust loss
   (:meth:`roughbrdf.quantity.Loss.curvature`; an M-estimator's sandwich, Huber 1981 §6.2: with
   ``J^T J`` the robust fits' standard errors were 1.1-1.4x too small, ``docs/fitting.md``,
   "Coverage on the shared paints"). Why not lmfit's ``(J^T J)^-1 chi2/(N - n_varys)``: that

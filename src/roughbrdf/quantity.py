@@ -197,7 +197,7 @@ class Loss(StrEnum):
         r = logx + math.log(k) - np.log(fs)
         if self is Loss.LOG:
             return r
-        return r * np.sqrt(2.0 / (1.0 + np.sqrt(1.0 + (r / ROBUST_SCALE) ** 2)))
+        return r * np.sqrt(2.0 / (1.0 + _soft_l1_s(r)))
 
     def scale_derivative(self, x: np.ndarray, f: np.ndarray, k: float, floor: float
                          ) -> np.ndarray:
@@ -211,11 +211,11 @@ class Loss(StrEnum):
             return x.copy()
         if self is Loss.LOG:
             return np.full(x.shape[0], 1.0 / k)
-        r = Loss.LOG.residual(x, f, k=k, floor=floor)
-        s = np.sqrt(1.0 + (r / ROBUST_SCALE) ** 2)
+        s = _soft_l1_s(Loss.LOG.residual(x, f, k=k, floor=floor))
         return np.sqrt(0.5 * (1.0 + s)) / s / k
 
-    def curvature(self, x: np.ndarray, f: np.ndarray, k: float, floor: float) -> np.ndarray:
+    def curvature(self, x: np.ndarray, f: np.ndarray, k: float, floor: float,
+                  logx: np.ndarray | None = None) -> np.ndarray:
         """Per sample, the cost's true curvature in the residual over the Gauss-Newton one: the
         factor ``rho''(r)/(2 (dr'/dr)²)`` that turns ``J^T J`` (``J`` the Jacobian of the
         transformed residuals ``r'``, ``rho = r'²``) into the Hessian of ``sum(rho(r))`` (over
@@ -228,6 +228,7 @@ class Loss(StrEnum):
         ``sum(r'²)``) and ``(dr'/dr)² = (1 + s)/(2s²)``, so the factor is ``2/(s (1 + s))``: 1 at
         ``r = 0``, ~``2c²/r²`` far out. Without it the standard errors of a robust fit are too
         small: by 1.12x for 5 % log-normal noise (``docs/fitting.md``, "Uncertainties").
+        ``logx``: ``ln x`` computed once, as for :meth:`residual`.
 
         Examples
         --------
@@ -240,8 +241,7 @@ class Loss(StrEnum):
         """
         if self is not Loss.ROBUST:
             return np.ones(x.shape[0])
-        r = Loss.LOG.residual(x, f, k=k, floor=floor)
-        s = np.sqrt(1.0 + (r / ROBUST_SCALE) ** 2)
+        s = _soft_l1_s(Loss.LOG.residual(x, f, k=k, floor=floor, logx=logx))
         return 2.0 / (s * (1.0 + s))
 
     def closed_form(self, d: np.ndarray, f: np.ndarray, w2: np.ndarray | None) -> float:
@@ -265,6 +265,12 @@ class Loss(StrEnum):
                 return 1.0
             t = float(np.dot(w2, r)) / wsum
         return math.exp(t if self is Loss.LOG else robust_log_scale(r, w2, t))
+
+
+def _soft_l1_s(r: np.ndarray) -> np.ndarray:
+    """``s = sqrt(1 + r²/c²)`` of log residuals ``r`` (``c`` = :data:`ROBUST_SCALE`): the one
+    quantity of the robust loss's residual, its scale derivative and its curvature."""
+    return np.sqrt(1.0 + (r / ROBUST_SCALE) ** 2)
 
 
 #: the report's line of each loss

@@ -350,7 +350,7 @@ class Objective:
         """Per sample, the factor of the cost's curvature over the Gauss-Newton one at model
         values ``f`` and scale ``k`` (:meth:`~roughbrdf.quantity.Loss.curvature`; the weights
         scale both alike). Non-finite factors (a sample without a residual) are 1."""
-        c = self.loss.curvature(self.x, f, k, self.floor)
+        c = self.loss.curvature(self.x, f, k, self.floor, logx=self.logx)
         return np.where(np.isfinite(c), c, 1.0)
 
     def scale_column(self, f: np.ndarray, k: float) -> np.ndarray:

@@ -85,3 +85,22 @@ def test_auto_keeps_a_metallic_model_for_the_metallic_paint(shared_data):
         assert p.peak_theta_deg == (0.0, 20.0, 40.0, 60.0)
         assert all(0.5 <= r <= 2.0 for r in p.peak_ratio), (c.channel, p.peak_ratio)
         assert p.max_albedo <= 1 + 1e-3
+
+
+@pytest.mark.slow
+def test_the_kept_fit_has_one_sided_limits_and_the_candidates_none(shared_data):
+    """``--model auto`` profiles the fit it keeps alone (fitting.results.one_sided): every
+    parameter of it on a physical limit gets a limit inside its search range (C8_Silver's flake
+    edge tint ``g_m`` = 0 at 525 and 630 nm), the candidates' fits none."""
+    res = _auto(shared_data, "C8_Silver")
+    on_limit = {(c.channel, nm): side for c in res.channels
+                for nm, side in c.limits.items() if side.startswith("physical")}
+    assert on_limit, "C8_Silver's kept fit has no parameter on a physical limit"
+    for c in res.channels:
+        physical = {nm for nm, side in c.limits.items() if side.startswith("physical")}
+        assert set(c.one_sided) == physical
+        for nm, u in c.one_sided.items():
+            lo, hi = c.bounds[nm]
+            assert u is not None and lo < u < hi and u != c.params[nm]
+    others = [cand for cand in res.model_choice.candidates if cand.result is not res]
+    assert all(c.one_sided == {} for cand in others for c in cand.result.channels)

@@ -17,6 +17,7 @@ from ..models.factory import is_auto
 from .choice.auto import fit_auto
 from .kinds.channels import fit_model, is_mueller, refuse_polarimetric_weight
 from .problem.options import FitOptions
+from .results.one_sided import add_one_sided
 
 if TYPE_CHECKING:
     from ..measurement import Measurement
@@ -86,5 +87,9 @@ def fit(model: Model | str, measurement: Measurement, *, options: FitOptions | N
     opts = FitOptions.of(options, keywords)
     if is_auto(model) and not is_mueller(measurement):  # Mueller fits refuse "auto"
         refuse_polarimetric_weight(opts)
-        return fit_auto(measurement, options=opts)
-    return fit_model(model, measurement, opts)
+        return fit_auto(measurement, options=opts)  # with the kept fit's one-sided limits
+    res = fit_model(model, measurement, opts)
+    if opts.joint or is_mueller(measurement):
+        return res
+    # the parameters on a physical limit: how far the data let them go (results.one_sided)
+    return add_one_sided(res, measurement, opts)

@@ -276,7 +276,9 @@ def _channel(content: dict[str, Any], chan: dict[str, Any], meas: Measurement,
         nfev=int(chan.get("nfev") or 0), starts=_starts(opts.get("starts")),
         elapsed=_number(chan.get("elapsed_s"), 0.0), free_scale=free_scale,
         at_bound={str(k): str(v) for k, v in (chan.get("at_bound") or {}).items()},
-        energy_constraint=_energy(chan.get("energy_constraint")), **samples)
+        energy_constraint=_energy(chan.get("energy_constraint")),
+        one_sided={str(k): None if v is None else _number(v, math.nan)
+                   for k, v in (chan.get("one_sided_95") or {}).items()}, **samples)
 
 
 def _metrics(metrics: dict[str, Any]) -> dict[str, Any]:

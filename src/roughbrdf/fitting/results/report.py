@@ -14,10 +14,11 @@ unit named, in radians (the library's unit, ``angles="rad"``, the default) or in
 always holds radians.
 
 Honest at bounds: a parameter at a bound (:func:`~roughbrdf.fitting.results.statistics.at_bound`) is
-printed ``(at the lower bound: no stderr) [physical limit]`` or ``(at the upper bound: no
-stderr) [search limit: not a result]`` (:func:`~roughbrdf.fitting.results.statistics.limit_kinds`)
-with a
-note why (the covariance is not meaningful at an active bound); the ``[[Plausibility]]`` block
+printed ``(at the lower bound: no stderr) [physical limit; <= 0.37 at 95 %, profile]`` (the
+one-sided limit of :mod:`~roughbrdf.fitting.results.one_sided`, where the fit has one) or ``(at
+the upper bound: no stderr) [search limit: not a result]``
+(:func:`~roughbrdf.fitting.results.statistics.limit_kinds`) with a note why (the covariance is
+not meaningful at an active bound); the ``[[Plausibility]]`` block
 gives the albedo by incidence and the model/data peak ratios
 (:mod:`~roughbrdf.fitting.results.plausibility`); a relative error is printed as a percentage only
 up
@@ -224,6 +225,11 @@ def _variable(c: ChannelFit, name: str, val: float | None, angle: str | None,
     if side is not None:
         kind = c.limits.get(name, "search").split("-")[0]
         what = "search limit: not a result" if kind == "search" else "physical limit"
+        if name in c.one_sided:  # its one-sided limit from the profile (results.one_sided)
+            u = c.one_sided[name]
+            what += (f"; {'<=' if side == 'lower' else '>='} {shown(u, 4)}{unit} at 95 %, "
+                     f"profile" if u is not None else "; not bounded by the data within the "
+                     "search range, profile")
         return f"{shown(val, 7)}{unit} (at the {side} bound: no stderr) [{what}] {tail}"
     se = c.stderr.get(name)
     return f"{shown(val, 7)}{unit} +/- {shown(se, 4)}{unit}{percent(se, val)} {tail}"

@@ -67,6 +67,11 @@ class ChannelFit:
         aside (:func:`~roughbrdf.fitting.results.statistics.bound_and_undetermined`): no standard
         error nor correlations; the others' covariance is computed with them held there.
         :attr:`limits` tells a physical edge from a search limit.
+    one_sided : dict
+        ``name -> u`` for the parameters on a physical limit: the one-sided 95 % limit from the
+        profile of the cost (None: not bounded within the search range;
+        :mod:`~roughbrdf.fitting.results.one_sided`); empty for joint, Mueller and
+        energy-constrained fits.
     correl : dict
         ``name -> {other: correlation}`` among the free parameters (and ``"scale"``).
     covar : numpy.ndarray
@@ -142,6 +147,8 @@ class ChannelFit:
     plausibility: Plausibility | None = field(default=None, repr=False)
     #: what the energy constraint did (:class:`~roughbrdf.fitting.energy.EnergyConstraint`)
     energy_constraint: Any = field(default=None, repr=False)
+    #: ``{name: u}``: the one-sided limits (:attr:`one_sided` above)
+    one_sided: dict[str, float | None] = field(default_factory=dict)
 
     @property
     def limits(self) -> dict[str, str]:
@@ -222,7 +229,8 @@ class ChannelFit:
                 "scale_stderr": self.scale_stderr, "correl": self.correl,
                 "excluded": self.excluded, "nfev": self.nfev, "elapsed_s": self.elapsed,
                 "model_spec": self.model.to_dict(), "energy_constraint": None
-                if self.energy_constraint is None else self.energy_constraint.to_dict()}
+                if self.energy_constraint is None else self.energy_constraint.to_dict(),
+                "one_sided_95": dict(self.one_sided)}
 
 
 @dataclass

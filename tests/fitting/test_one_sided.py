@@ -188,3 +188,15 @@ def test_threshold_is_the_sandwich_calibration_of_the_standard_errors():
                       0.5 * kappa * Z * Z, 1e-3)
     assert u is not None
     assert (u - rho) / (Z * c.stderr["rho"]) == pytest.approx(1.0, abs=0.03)
+
+
+def test_a_limit_at_the_upper_edge_mirrors_the_lower():
+    """rho on its upper physical limit 1 (data above 1/pi): the limit lies below it, at the
+    mirrored closed form (the distances below the edge, y = 1/pi - x, as x above)."""
+    x = 1 / np.pi + 0.002 + 0.01 * np.random.default_rng(6).standard_normal(50)
+    obj = _lambertian_objective(x)
+    u = one_sided_limits(obj, {"rho": 1.0}, {"rho": "physical-upper"})["rho"]
+    mirrored = 1.0 - _closed(1 / np.pi - x)
+    assert u is not None
+    # the far end of the bracket: at or below the closed form, within RTOL of its distance
+    assert mirrored - RTOL * (1 - mirrored) <= u <= mirrored

@@ -125,8 +125,8 @@ def test_every_option_of_fit_is_a_field_with_the_same_default():
     fields = {f.name: f.default for f in dataclasses.fields(FitOptions)}
     assert fields["loss"] == "auto" and fields["starts"] == 8 and fields["seed"] == 0
     assert fields["subsample"] == 1000 and fields["aperture_points"] == 19
-    assert len(fields) == 27 and fields["energy_constraint"] is True
-    assert fields["wavelength"] is None
+    assert len(fields) == 28 and fields["energy_constraint"] is True
+    assert fields["wavelength"] is None and fields["intervals"] == "wald"
     assert "model" not in fields and "measurement" not in fields
     assert FitOptions().changed() == {} and FitOptions(fix=[]).changed() == {}
 

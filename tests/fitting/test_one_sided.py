@@ -49,7 +49,8 @@ def below_zero() -> tuple[rb.FitResult, np.ndarray]:
     """A Lambertian fitted to data whose mean is below 0: ``rho`` on its physical limit."""
     x = -0.002 + 0.01 * np.random.default_rng(3).standard_normal(60)
     meas = rb.Measurement(*_flat(x), x)
-    return rb.fit("lambertian", meas, loss="absolute", starts=1, progress=False), x
+    return rb.fit("lambertian", meas, loss="absolute", starts=1, intervals="profile",
+                  progress=False), x
 
 
 def test_the_fit_gives_the_closed_form_limit(below_zero):
@@ -127,7 +128,7 @@ def test_refitted_profile_agrees_with_scipy():
     it a bracket's width (RTOL) inside."""
     meas, _ = _dip()
     model = rb.model("lambertian+microfacet", microfacet_alpha=0.3)
-    res = rb.fit(model, meas, loss="log", progress=False,
+    res = rb.fit(model, meas, loss="log", progress=False, intervals="profile",
                  fix=["microfacet_alpha", "microfacet_n", "microfacet_k"])
     c = res[0]
     name = next(nm for nm in c.free if nm.endswith("ks"))
@@ -159,11 +160,16 @@ def test_refitted_profile_agrees_with_scipy():
     assert profile(u * (1 - 2 * RTOL)) < threshold
 
 
-def test_joint_fits_carry_no_limits():
-    """The profile is of one channel's cost; a joint fit's channels share parameters."""
+def test_only_when_asked():
+    """Opt-in (a profile costs many refits): the default fit reports the physical limit alone,
+    in the report as before; a joint fit (whose channels share parameters) has none."""
     x = -0.002 + 0.01 * np.random.default_rng(4).standard_normal(40)
-    meas = rb.Measurement(*_flat(x), np.stack([x, x + 0.001], axis=1), channels=["a", "b"])
-    res = rb.fit("lambertian", meas, loss="absolute", joint=True, starts=1, progress=False)
+    meas = rb.Measurement(*_flat(x), x)
+    res = rb.fit("lambertian", meas, loss="absolute", starts=1, progress=False)
+    assert res[0].limits == {"rho": "physical-lower"} and res[0].one_sided == {}
+    assert "[physical limit] (init" in res.report()
+    two = rb.Measurement(*_flat(x), np.stack([x, x + 0.001], axis=1), channels=["a", "b"])
+    res = rb.fit("lambertian", two, loss="absolute", joint=True, starts=1, progress=False)
     assert all(c.one_sided == {} for c in res.channels)
 
 

@@ -67,7 +67,7 @@ FIT_OPTIONS = {"model": "--model", "fix": "--fix", "bounds": "--bounds", "channe
                "overwrite": "--force", "plots": "--plots/--no-plots", "joint": "--joint",
                "shared": "--shared", "extrapolated": "--keep-extrapolated",
                "candidates": "--models", "cv": "--cv/--no-cv", "wavelength": "--wavelength",
-               "max_rows": "--max-rows"}
+               "max_rows": "--max-rows", "intervals": "--intervals"}
 COMPARE_OPTIONS = {"candidates": "--models", "models": "--models", "cv": "--cv/--no-cv",
                    "channel": "--channel", "loss": "--loss", "starts": "--starts",
                    "joint": "--joint", "quantity": "--quantity", "angles": "--angles-in",

@@ -368,7 +368,7 @@ FIT_ORDER = ["file", "model", "models", "cv", "joint", "shared", "per_incidence"
              "keep_extrapolated", "out",
              "param", "fix", "bounds", "channel", "loss", "starts", "quantity", "angles_in",
              "relative_to", "file_format", "nonfinite", "negative", "seed", "free_scale",
-             "aperture", "theta_r_max", "source_exclusion", "plots", "force", "quiet"]
+             "aperture", "theta_r_max", "source_exclusion", "intervals", "plots", "force", "quiet"]
 #: the verb's own parameters (the shared ones: :data:`roughbrdf.cli.options.TABLE`)
 FIT_OWN: dict[str, tuple[Any, Any]] = {
     "file": (Annotated[str, typer.Argument(help="measurement file (.astm, .dat/.alta, .csv, "

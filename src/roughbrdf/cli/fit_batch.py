@@ -120,7 +120,7 @@ BATCH_ORDER = ["paths", "model", "out", "workers", "scheduler", "resume", "time_
                "models", "cv", "joint", "shared", "keep_extrapolated", "param", "fix",
                "bounds", "channel", "loss", "starts", "quantity", "angles_in", "relative_to",
                "file_format", "nonfinite", "negative", "seed", "free_scale", "aperture",
-               "theta_r_max", "source_exclusion", "plots", "force", "quiet"]
+               "theta_r_max", "source_exclusion", "intervals", "plots", "force", "quiet"]
 #: the verb's own parameters (the shared ones: :data:`roughbrdf.cli.options.TABLE`)
 BATCH_OWN: dict[str, tuple[Any, Any]] = {
     "paths": (Annotated[list[str], typer.Argument(

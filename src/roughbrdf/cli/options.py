@@ -104,6 +104,12 @@ EnergyConstraintOption = Annotated[bool, typer.Option(
          "0, 5, ... 85, 89 deg) under albedo <= 1 there; --no-energy-constraint: the "
          "unconstrained fit")]
 
+IntervalsOption = Annotated[str, typer.Option(
+    "--intervals", metavar="KIND",
+    help="wald (default): standard errors; profile: also 68 % and 95 % intervals, and "
+         "one-sided 95 % limits of parameters on a physical limit, from the profile of the "
+         "cost, the other parameters refitted (2-4 refits per limit)")]
+
 WavelengthOption = Annotated[str | None, typer.Option(
     "--wavelength", metavar="WL",
     help="wavelength of every channel for models that need one (k-correlation), in um or "
@@ -122,11 +128,11 @@ TABLE: dict[str, tuple[Any, Any]] = {
     "free_scale": (FreeScaleOption, None), "aperture": (ApertureOption, None),
     "theta_r_max": (ThetaRMaxOption, None), "source_exclusion": (SourceExclusionOption, None),
     "plots": (PlotsOption, True), "energy_constraint": (EnergyConstraintOption, True),
-    "wavelength": (WavelengthOption, None),
+    "wavelength": (WavelengthOption, None), "intervals": (IntervalsOption, "wald"),
 }
 #: the CLI values that are FitOptions fields as they are
 _AS_GIVEN = ("loss", "starts", "seed", "nonfinite", "negative", "relative_to", "free_scale",
-             "joint", "energy_constraint", "wavelength")
+             "joint", "energy_constraint", "wavelength", "intervals")
 #: options every verb that fits takes (those whose ``order`` has ``starts``), placed after it
 _FITTING = ("energy_constraint", "wavelength")
 

@@ -13,11 +13,12 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from ..errors import ArgumentError
 from ..models.factory import is_auto
 from .choice.auto import fit_auto
 from .kinds.channels import fit_model, is_mueller, refuse_polarimetric_weight
 from .problem.options import FitOptions
-from .results.one_sided import add_one_sided
+from .results.intervals import add_profiles
 
 if TYPE_CHECKING:
     from ..measurement import Measurement
@@ -87,9 +88,12 @@ def fit(model: Model | str, measurement: Measurement, *, options: FitOptions | N
     opts = FitOptions.of(options, keywords)
     if is_auto(model) and not is_mueller(measurement):  # Mueller fits refuse "auto"
         refuse_polarimetric_weight(opts)
-        return fit_auto(measurement, options=opts)  # with the kept fit's one-sided limits
+        return fit_auto(measurement, options=opts)  # the kept fit's profiles if asked
+    if is_mueller(measurement) and opts.intervals == "profile":
+        raise ArgumentError("intervals", "profile intervals are for BRDF channels fitted on "
+                            "their own, not Mueller elements", value=opts.intervals)
     res = fit_model(model, measurement, opts)
     if opts.joint or is_mueller(measurement):
         return res
-    # the parameters on a physical limit: how far the data let them go (results.one_sided)
-    return add_one_sided(res, measurement, opts)
+    # with intervals='profile': one-sided limits and profile intervals (results.intervals)
+    return add_profiles(res, measurement, opts)

@@ -277,8 +277,33 @@ def _channel(content: dict[str, Any], chan: dict[str, Any], meas: Measurement,
         elapsed=_number(chan.get("elapsed_s"), 0.0), free_scale=free_scale,
         at_bound={str(k): str(v) for k, v in (chan.get("at_bound") or {}).items()},
         energy_constraint=_energy(chan.get("energy_constraint")),
-        one_sided={str(k): None if v is None else _number(v, math.nan)
-                   for k, v in (chan.get("one_sided_95") or {}).items()}, **samples)
+        one_sided=_one_sided(chan.get("one_sided_95")),
+        intervals=_intervals(chan.get("profile_intervals")), **samples)
+
+
+def _one_sided(rec: Any) -> dict[str, float | None]:
+    """The recorded one-sided limits (``{name: u}``, null where the data did not bound it);
+    a record that is not a mapping gives none."""
+    if not isinstance(rec, dict):
+        return {}
+    return {str(k): None if v is None else _number(v, math.nan) for k, v in rec.items()}
+
+
+def _intervals(rec: Any) -> dict[str, dict[str, tuple[float | None, float | None]]]:
+    """The recorded profile intervals (``{name: {level: [lo, hi]}}``, null for a side the
+    data did not bound); what is not such a record is left out."""
+    out: dict[str, dict[str, tuple[float | None, float | None]]] = {}
+    for name, by in (rec or {}).items() if isinstance(rec, dict) else ():
+        if not isinstance(by, dict):
+            continue
+        out[str(name)] = {str(lv): (_side(v, 0), _side(v, 1)) for lv, v in by.items()
+                          if isinstance(v, list) and len(v) == 2}
+    return out
+
+
+def _side(v: list[Any], i: int) -> float | None:
+    """One end of a recorded interval: None where it is null."""
+    return None if v[i] is None else _number(v[i], math.nan)
 
 
 def _metrics(metrics: dict[str, Any]) -> dict[str, Any]:

@@ -51,7 +51,7 @@ from ...models import Model, spec_text
 from ..kinds.channels import fit_model, is_mueller
 from ..problem.options import FitOptions
 from ..problem.plan import channel_indices
-from ..results.one_sided import add_one_sided
+from ..results.intervals import add_profiles
 from ..results.plausibility import EnergyWarning, warn_energy
 from .compare import (
     Candidate,
@@ -108,8 +108,8 @@ def fit_auto(measurement: Measurement, candidates: Sequence[Model | str] | str |
         else:
             choice = compare(measurement, models, cv=cv, options=given)
     best = choice.best.result
-    if not given.joint and not is_mueller(measurement):  # the kept fit's alone (one_sided)
-        add_one_sided(best, measurement, given)
+    if not given.joint and not is_mueller(measurement):  # the kept fit's alone, if asked
+        add_profiles(best, measurement, given)
     warn_energy(best, stacklevel=3)
     best.model_choice = choice
     best.model_name = choice.best.label

@@ -272,6 +272,9 @@ def fit_per_incidence(model: Model | str, measurement: Measurement, *, max_rows:
     if not isinstance(max_rows, int) or max_rows < 2:
         raise ArgumentError("max_rows", "must be an integer >= 2", value=max_rows)
     opts = FitOptions.of(options, keywords, caller="fit_per_incidence")
+    if opts.intervals == "profile":  # each row is a fit_model fit: no profiles there
+        raise ArgumentError("intervals", "a per-incidence fit has no profile intervals",
+                            value=opts.intervals)
     start = as_model(model)
     angles = np.sort(measurement.incidences())
     if angles.size < 1:

@@ -194,6 +194,12 @@ class FitOptions:
         wavelength of every channel, in µm or as a string with a unit (``"630nm"``). None
         (default): each channel's from the file or its name (:mod:`~roughbrdf.fitting.
         wavelengths`); a model that needs one and finds none is refused.
+    intervals : {"wald", "profile"}
+        ``"wald"`` (default): the standard errors alone. ``"profile"``: also, from the profile
+        of the cost, the 68 % and 95 % intervals of every fitted parameter with a standard
+        error (:mod:`~roughbrdf.fitting.results.intervals`) and the one-sided 95 % limit of
+        each on a physical limit (:mod:`~roughbrdf.fitting.results.one_sided`); 2-4 refits
+        of the other parameters per limit and side.
 
     Raises
     ------
@@ -202,7 +208,7 @@ class FitOptions:
         model and the data: the aperture and its rule, the fit domain, the loss, ``nonfinite``,
         ``negative``, ``extrapolated``, the search counts and seed, ``scale``, ``joint``,
         ``shared`` without a joint fit, ``polarimetric_weight``, ``energy_constraint``,
-        ``wavelength``.
+        ``wavelength``, ``intervals``.
     """
 
     channel: int | str | Sequence[int | str] | None = None
@@ -232,6 +238,7 @@ class FitOptions:
     progress: bool | None = None
     energy_constraint: bool = True
     wavelength: float | str | None = None
+    intervals: str = "wald"
 
     def __post_init__(self) -> None:
         # in the order the fit met them before the options were one object
@@ -254,6 +261,11 @@ class FitOptions:
             raise ArgumentError("energy_constraint", "must be True or False",
                                 value=self.energy_constraint)
         parse_wavelength(self.wavelength)  # ArgumentError naming wavelength
+        if self.intervals not in ("wald", "profile"):  # results.intervals.INTERVALS
+            raise ArgumentError("intervals", "must be 'wald' or 'profile'", value=self.intervals)
+        if self.intervals == "profile" and self.joint:  # the profile is of one channel's cost
+            raise ArgumentError("intervals", "profile intervals are for channels fitted on "
+                                "their own, not a joint fit", value=self.intervals)
 
     @classmethod
     def of(cls, options: FitOptions | None = None, keywords: Mapping[str, Any] | None = None,

@@ -68,7 +68,8 @@ def report(result: FitResult, *, min_correl: float = 0.1, angles: str = "rad") -
         raise ArgumentError("angles", "must be 'rad' or 'deg'", value=angles)
     lines = _header(result)
     for i, c in enumerate(result.channels):
-        lines += ["", *_channel(c), *_variables(c, angles), *_correlations(c, min_correl),
+        lines += ["", *_channel(c), *_variables(c, angles), *_profile_lines(c, angles),
+                  *_correlations(c, min_correl),
                   *result.plausibility(i).lines()]
         # a Mueller fit's channel adds its normalized elements (fitting.kinds.polarimetric)
         lines += getattr(c, "report_lines", list)()
@@ -260,6 +261,29 @@ def _variables(c: ChannelFit, angles: str = "rad") -> list[str]:
                      f"{fmt(c.scale_stderr, 4)}{percent(c.scale_stderr, c.scale)} (closed form)")
     elif c.scale != 1.0:
         lines.append(f"    {'scale K':<{width}}: {fmt(c.scale, 7)} (given)")
+    return lines
+
+
+def _profile_lines(c: ChannelFit, angles: str) -> list[str]:
+    """The ``[[Profile intervals]]`` block (``intervals="profile"``; none: [])
+    (:mod:`~roughbrdf.fitting.results.intervals`)."""
+    if not c.intervals:
+        return []
+    angular = _angle_parameters(c)
+    width = max(len(n) for n in c.intervals)
+    lines = ["[[Profile intervals]] (where the cost, the others refitted, rises as the standard "
+             "errors calibrate it)"]
+    for name, by in c.intervals.items():
+        deg = angles == "deg" and name in angular
+
+        def show(v: float | None, deg: bool = deg) -> str:
+            return "none" if v is None else fmt(math.degrees(v) if deg else v, 5)
+
+        unit = f" {angles}" if name in angular else ""
+        lines.append(f"    {name:<{width}}: " + "  ".join(
+            f"{lv} % [{show(lo)}, {show(hi)}]{unit}" for lv, (lo, hi) in by.items()))
+    if any(v is None for by in c.intervals.values() for pair in by.values() for v in pair):
+        lines.append("    (none: the data do not bound that side within the search range)")
     return lines
 
 

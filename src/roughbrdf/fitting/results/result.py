@@ -68,10 +68,14 @@ class ChannelFit:
         error nor correlations; the others' covariance is computed with them held there.
         :attr:`limits` tells a physical edge from a search limit.
     one_sided : dict
-        ``name -> u`` for the parameters on a physical limit: the one-sided 95 % limit from the
-        profile of the cost (None: not bounded within the search range;
-        :mod:`~roughbrdf.fitting.results.one_sided`); empty for joint, Mueller and
-        energy-constrained fits.
+        ``name -> u`` for the parameters on a physical limit, with ``intervals="profile"``: the
+        one-sided 95 % limit from the profile of the cost (None: not bounded within the search
+        range; :mod:`~roughbrdf.fitting.results.one_sided`); empty otherwise and for joint,
+        Mueller and energy-constrained fits.
+    intervals : dict
+        ``name -> {"68": (lo, hi), "95": (lo, hi)}``: profile intervals, with
+        ``intervals="profile"`` (:mod:`~roughbrdf.fitting.results.intervals`; a side None where
+        the data do not bound it within the search range); else empty.
     correl : dict
         ``name -> {other: correlation}`` among the free parameters (and ``"scale"``).
     covar : numpy.ndarray
@@ -149,6 +153,9 @@ class ChannelFit:
     energy_constraint: Any = field(default=None, repr=False)
     #: ``{name: u}``: the one-sided limits (:attr:`one_sided` above)
     one_sided: dict[str, float | None] = field(default_factory=dict)
+    #: profile intervals (:attr:`intervals` above)
+    intervals: dict[str, dict[str, tuple[float | None, float | None]]] = field(
+        default_factory=dict)
 
     @property
     def limits(self) -> dict[str, str]:
@@ -230,7 +237,9 @@ class ChannelFit:
                 "excluded": self.excluded, "nfev": self.nfev, "elapsed_s": self.elapsed,
                 "model_spec": self.model.to_dict(), "energy_constraint": None
                 if self.energy_constraint is None else self.energy_constraint.to_dict(),
-                "one_sided_95": dict(self.one_sided)}
+                "one_sided_95": dict(self.one_sided),
+                "profile_intervals": {nm: {lv: list(v) for lv, v in by.items()}
+                                      for nm, by in self.intervals.items()}}
 
 
 @dataclass

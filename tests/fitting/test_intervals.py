@@ -18,11 +18,12 @@ from typer.testing import CliRunner
 
 import roughbrdf as rb
 from roughbrdf.cli import app
+from roughbrdf.demo import default_measurement_path
 from roughbrdf.errors import ArgumentError
 from roughbrdf.fitting import ChannelData
 from roughbrdf.fitting.kinds.per_incidence import fit_per_incidence
 from roughbrdf.fitting.problem.objective import Objective, ObjectiveSpec
-from roughbrdf.fitting.results.intervals import LEVELS
+from roughbrdf.fitting.results.intervals import LEVELS, NOT_UNDER_CONSTRAINT
 from roughbrdf.fitting.results.one_sided import RTOL, dispersion
 
 #: fits and a CLI run: too slow without the JIT (make test-nojit deselects them)
@@ -147,3 +148,15 @@ def test_command_line_writes_them(tmp_path):
     bad = CliRunner().invoke(app, ["fit", str(path), "-m", "lambertian", "--intervals", "x",
                                    "--out", str(tmp_path / "bad")])
     assert bad.exit_code != 0 and "--intervals x: must be 'wald' or 'profile'" in bad.output
+
+
+def test_an_active_energy_constraint_says_why_there_are_none():
+    """TR75 on the embedded cement data is refitted under the energy constraint (active at
+    grazing incidence): no profile of the unconstrained cost is offered, and the message (so the
+    report) says why."""
+    meas = rb.read(default_measurement_path())
+    res = rb.fit("trowbridge-reitz-1975", meas, starts=2, intervals="profile", progress=False)
+    c = res[0]
+    assert c.energy_constraint.active
+    assert c.intervals == {} and c.one_sided == {}
+    assert NOT_UNDER_CONSTRAINT in c.message and "energy_constraint=False" in res.report()

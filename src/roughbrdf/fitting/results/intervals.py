@@ -43,7 +43,7 @@ if TYPE_CHECKING:
     from ..problem.options import FitOptions
     from .result import ChannelFit, FitResult
 
-__all__ = ["INTERVALS", "LEVELS", "add_profiles", "profile_intervals"]
+__all__ = ["INTERVALS", "LEVELS", "NOT_UNDER_CONSTRAINT", "add_profiles", "profile_intervals"]
 
 #: the values of the ``intervals`` option
 INTERVALS = ("wald", "profile")
@@ -51,6 +51,11 @@ INTERVALS = ("wald", "profile")
 LEVELS = {"68": 1.0, "95": 2.0}
 
 Interval = tuple[float | None, float | None]
+
+#: what a channel's message says when its profiles were asked for and the energy constraint is
+#: active there
+NOT_UNDER_CONSTRAINT = ("; no profile intervals nor one-sided limits: the energy constraint "
+                        "is active (fit with energy_constraint=False for them)")
 
 
 def profile_intervals(obj: Objective, params: Mapping[str, Any], stderr: Mapping[str, Any],
@@ -135,7 +140,10 @@ def add_profiles(result: FitResult, measurement: Measurement, options: FitOption
     add_one_sided(result, measurement, options)
     for c in result.channels:
         if c.energy_constraint is not None and c.energy_constraint.active:
-            continue  # the profile would have to hold the constraint (one_sided's notes)
+            # the profile would have to hold the constraint (one_sided's notes): said, since
+            # they were asked for
+            c.message += NOT_UNDER_CONSTRAINT
+            continue
         names = _with_stderr(c)
         obj = objective_of(c, measurement, options) if names else None
         if obj is not None:

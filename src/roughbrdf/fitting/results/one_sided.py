@@ -55,6 +55,7 @@ from ..problem.data import prepare_channel
 from ..problem.objective import Objective, ObjectiveSpec
 from ..problem.plan import FitPlan
 from ..solvers.bounded import bounded_lm
+from .statistics import Covariance
 
 if TYPE_CHECKING:
     from ...measurement import Measurement
@@ -102,16 +103,16 @@ def dispersion(obj: Objective, theta: np.ndarray, j: int) -> float:
     if obj.spec.free_scale:
         cols.append(obj.scale_column(f, k)[:, None])
     jac = np.hstack(cols)
-    # H = J^T diag(c) J: the M-estimator's curvature (statistics.Covariance)
-    curv = jac.T @ (jac * obj.curvature_of(f, k)[:, None])
-    meat = jac.T @ (jac * (r * r)[:, None])
-    try:
-        inv = np.linalg.inv(curv)
+    curv = obj.curvature_of(f, k)
+    try:  # H^-1 and the sandwich V of statistics.Covariance, with the parameter free
+        inv = Covariance.curvature_inverse(jac, curv)
     except np.linalg.LinAlgError:
         return math.nan
-    dof = max(r.size - jac.shape[1], 1)
-    var = float((inv @ meat @ inv)[j, j]) * r.size / dof
-    return var / float(inv[j, j]) if inv[j, j] > 0 else math.nan
+    dof = r.size - jac.shape[1]
+    cov = Covariance.from_jacobian(jac, [str(i) for i in range(jac.shape[1])],
+                                   chi2=math.nan, dof=dof, residual=r, curvature=curv)
+    var = float(cov.matrix[j, j])
+    return var / float(inv[j, j]) if inv[j, j] > 0 and math.isfinite(var) else math.nan
 
 
 def profile_limit(rise: Callable[[float], float], bound: float, far: float, threshold: float,

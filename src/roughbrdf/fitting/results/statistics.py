@@ -252,13 +252,7 @@ class Covariance:
         if p == 0:
             return cls(np.empty((0, 0)), names)
         try:
-            # H = (sqrt(c) J)^T (sqrt(c) J): its inverse through the SVD of the scaled rows
-            bread = jmat if curvature is None or residual is None \
-                else jmat * np.sqrt(curvature)[:, None]
-            _, s, vt = np.linalg.svd(bread, full_matrices=False)
-            if not np.all(np.isfinite(s)) or s[0] == 0 or s[-1] <= s[0] * 1e-12:
-                raise np.linalg.LinAlgError("singular")
-            inv = (vt.T / (s * s)) @ vt
+            inv = cls.curvature_inverse(jmat, None if residual is None else curvature)
             if residual is None:
                 return cls(inv * (chi2 / max(dof, 1)), names)
             meat = (jmat * (residual * residual)[:, None]).T @ jmat
@@ -266,6 +260,24 @@ class Covariance:
         except np.linalg.LinAlgError:
             return cls(np.full((p, p), np.nan), names,
                        "; covariance not estimated (singular J^T J: a parameter has no effect)")
+
+    @staticmethod
+    def curvature_inverse(jmat: np.ndarray, curvature: np.ndarray | None = None) -> np.ndarray:
+        """``H^-1``, ``H = J^T diag(c) J`` (``c`` the loss's curvature factors, None: all 1),
+        through the SVD of ``sqrt(c) J``; ``numpy.linalg.LinAlgError`` where ``H`` is singular
+        (a condition number of ``J`` above 1e12).
+
+        Examples
+        --------
+        >>> Covariance.curvature_inverse(np.array([[1.0, 0.0], [0.0, 2.0]])).tolist()
+        [[1.0, 0.0], [0.0, 0.25]]
+        """
+        # H = (sqrt(c) J)^T (sqrt(c) J): its inverse through the SVD of the scaled rows
+        bread = jmat if curvature is None else jmat * np.sqrt(curvature)[:, None]
+        _, s, vt = np.linalg.svd(bread, full_matrices=False)
+        if not np.all(np.isfinite(s)) or s[0] == 0 or s[-1] <= s[0] * 1e-12:
+            raise np.linalg.LinAlgError("singular")
+        return (vt.T / (s * s)) @ vt
 
     @classmethod
     def at_optimum(cls, obj: Objective, theta: np.ndarray, f: np.ndarray, k: float, *,

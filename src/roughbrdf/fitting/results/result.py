@@ -21,6 +21,7 @@ import numpy as np
 
 from ...instrument import Aperture, aperture_average
 from ...jsonsafe import clean_json
+from ...plot import load_matplotlib
 from ...quantity import Quantity
 from ..problem.data import input_source
 from .fit_json import channel_model, check_fit_channels, fitted_models, read_fit_json
@@ -511,6 +512,7 @@ def _png_writer(result: FitResult, channel: int, dpi: int) -> Callable[[IO[bytes
     """A function drawing ``result``'s figure of ``channel`` as PNG into the open (staged)
     file it is given."""
     def write(fh: IO[bytes]) -> None:
+        load_matplotlib()  # Ctrl-C held while its compiled modules load
         fig, _ = result.plot(channel)
         fig.savefig(fh, format="png", dpi=dpi, metadata={"Software": "roughbrdf"})
     return write
@@ -519,5 +521,6 @@ def _png_writer(result: FitResult, channel: int, dpi: int) -> Callable[[IO[bytes
 def _figure_writer(draw: Callable[[], Any], dpi: int) -> Callable[[IO[bytes]], None]:
     """A function drawing the figure ``draw()`` returns as PNG into the file it is given."""
     def write(fh: IO[bytes]) -> None:
+        load_matplotlib()  # Ctrl-C held while its compiled modules load
         draw().savefig(fh, format="png", dpi=dpi, metadata={"Software": "roughbrdf"})
     return write

@@ -42,6 +42,7 @@ from numpy.typing import ArrayLike
 
 from . import geometry
 from .instrument import Aperture, aperture_average
+from .mpl_load import load_matplotlib
 from .quantity import Quantity, relative_scale
 
 if TYPE_CHECKING:
@@ -52,7 +53,6 @@ if TYPE_CHECKING:
     from .models.base import Model
 
 __all__ = [
-    "load_matplotlib",
     "new_axes",
     "disk_decorations",
     "hemisphere_grid",
@@ -79,24 +79,6 @@ SIGNED_LABEL = r"signed reflection angle $\theta_r$ [deg] (negative = source sid
 # --------------------------------------------------------------------------------------------
 # helpers
 # --------------------------------------------------------------------------------------------
-def load_matplotlib() -> None:
-    """Import the compiled parts of Matplotlib a figure and its PNG need (``figure``, the Agg
-    backend, Pillow's PNG writer), Ctrl-C held while they load.
-
-    A Ctrl-C that lands while a compiled module initializes can leave it half made, and the
-    interpreter then aborted at exit ("Fatal Python error: PyThreadState_Get", exit -6 instead
-    of 130: ``tests/cli/test_cli_safety.py``, Ctrl-C 0.15 s into saving a fit's figures), as it
-    did for SciPy's Sobol tables (:func:`roughbrdf.fitting.solvers.search.sobol_points`). Held,
-    the interrupt comes right after the imports. A no-op once they are loaded.
-    """
-    from .interrupts import held_interrupts
-
-    with held_interrupts():
-        import matplotlib.backends.backend_agg  # noqa: F401
-        import matplotlib.figure  # noqa: F401
-        import PIL.PngImagePlugin  # noqa: F401
-
-
 def new_axes(ax: Axes | None = None, *, polar: bool = False,
              figsize: tuple[float, float] = (6.4, 4.8)) -> tuple[Figure, Axes]:
     """Return ``(fig, ax)``: ``ax``'s figure, or a new pyplot-free figure with one axes."""
@@ -105,10 +87,8 @@ def new_axes(ax: Axes | None = None, *, polar: bool = False,
         if fig is None:  # an axes always belongs to a figure once created
             raise ValueError("ax must belong to a figure")
         return fig, ax  # type: ignore[return-value]  # a SubFigure acts as a Figure here
-    load_matplotlib()
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=figsize, layout="constrained")
+    # a new Figure, Matplotlib's compiled modules loaded with Ctrl-C held (mpl_load)
+    fig = load_matplotlib()(figsize=figsize, layout="constrained")
     ax = fig.add_subplot(projection="polar" if polar else None)
     return fig, ax
 

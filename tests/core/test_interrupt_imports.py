@@ -1,5 +1,5 @@
 """A Ctrl-C while Matplotlib's compiled modules load is held until they are loaded
-(:func:`roughbrdf.plot.load_matplotlib`).
+(:func:`roughbrdf.mpl_load.load_matplotlib`).
 
 Why: a Ctrl-C 0.15 s into saving a fit's figures once landed while those modules initialized and
 the interpreter aborted at exit ("Fatal Python error: PyThreadState_Get", exit -6 instead of 130;
@@ -26,7 +26,7 @@ SCRIPT = textwrap.dedent("""
                 os.kill(os.getpid(), signal.SIGINT)  # delivered at the next bytecode
             return None
 
-    from roughbrdf.plot import load_matplotlib
+    from roughbrdf.mpl_load import load_matplotlib
     sys.meta_path.insert(0, Strike())
     try:
         {call}

@@ -21,7 +21,7 @@ import numpy as np
 
 from ...instrument import Aperture, aperture_average
 from ...jsonsafe import clean_json
-from ...plot import load_matplotlib
+from ...mpl_load import load_matplotlib
 from ...quantity import Quantity
 from ..problem.data import input_source
 from .fit_json import channel_model, check_fit_channels, fitted_models, read_fit_json

@@ -28,9 +28,10 @@ TOP = "roughbrdf"
 #: its modules) of ``roughbrdf``
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # utilities that import nothing of the package above this layer: errors, interrupts (the
-    # kernels check them), JSON, the registries, atomic output and its journal
+    # kernels check them), JSON, the registries, atomic output and its journal, Matplotlib's
+    # modules loaded with Ctrl-C held
     ("base", ("errors", "interrupts", "jsonsafe", "journal", "output", "registry",
-              "result_check", "rich_display")),
+              "result_check", "rich_display", "mpl_load")),
     ("kernels", ("_kernels",)),
     ("physics", ("geometry_frames", "geometry", "special", "fresnel", "distributions",
                  "shadowing", "diffuse", "mueller", "stokes", "polarization", "quantity")),

@@ -32,7 +32,7 @@ from coverage_paints import DATA, FLOOR, PAINTS, file_floor, geometry, noisy
 
 import roughbrdf as rb
 from roughbrdf.fitting import FitOptions
-from roughbrdf.fitting.results.one_sided import add_one_sided
+from roughbrdf.fitting.results.intervals import add_profiles
 
 PAINT = "C8_Silver"
 NAME = "g_m"
@@ -54,8 +54,9 @@ def run(truth_value: float, seeds: int, channel: str) -> str:
     for seed in range(seeds):
         synthetic = noisy(truth, geo, seed, floor)
         # rb.fit(..., intervals="profile") without the two-sided intervals (not counted here)
-        (c,) = add_one_sided(rb.fit(spec, synthetic, progress=False), synthetic,
-                             FitOptions(progress=False)).channels
+        (c,) = add_profiles(rb.fit(spec, synthetic, progress=False), synthetic,
+                            FitOptions(intervals="profile", progress=False),
+                            two_sided=False).channels
         if c.limits.get(NAME, "").startswith("physical"):
             on_limit += 1
             u = c.one_sided.get(NAME)

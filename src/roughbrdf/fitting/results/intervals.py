@@ -36,7 +36,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..problem.objective import Objective
-from .one_sided import add_one_sided, dispersion, held_cost, objective_of, profile_limit
+from .one_sided import (
+    calibration,
+    held_cost,
+    objective_of,
+    one_sided_limits,
+    profile_limit,
+    rise_above,
+)
 
 if TYPE_CHECKING:
     from ...measurement import Measurement
@@ -85,33 +92,31 @@ def profile_intervals(obj: Objective, params: Mapping[str, Any], stderr: Mapping
     """
     spec = obj.spec
     theta = np.array([float(params[nm]) for nm in spec.free])
+    kappas = calibration(obj, theta)[0] if names else np.empty(0)
+    at_fit = 0.5 * obj.cost(theta) if names else math.nan
     out: dict[str, dict[str, Interval]] = {}
     for name in names:
         j = spec.free.index(name)
-        kappa = dispersion(obj, theta, j)
+        kappa = float(kappas[j])
         if not (math.isfinite(kappa) and kappa > 0):
             continue  # no calibration (a singular curvature): no interval claimed
         se = stderr.get(name)
         width = float(spec.upper[j] - spec.lower[j])
         first = float(se) if se is not None and math.isfinite(se) and se > 0 \
             else (width / 20.0 if math.isfinite(width) else 1.0)
-        sides = [_side(obj, theta, j, float(bound), kappa, first)
+        sides = [_side(obj, theta, j, float(bound), kappa, first, at_fit)
                  for bound in (spec.lower[j], spec.upper[j])]
         out[name] = {level: (sides[0][level], sides[1][level]) for level in LEVELS}
     return out
 
 
 def _side(obj: Objective, theta: np.ndarray, j: int, far: float, kappa: float,
-          first: float) -> dict[str, float | None]:
-    """Both levels' ends on the side of ``far`` (a search bound) of free parameter ``j``; the
-    95 % search starts from the 68 % end (twice its distance: the quadratic guess)."""
-    held = held_cost(obj, theta, j)
+          first: float, at_fit: float) -> dict[str, float | None]:
+    """Both levels' ends on the side of ``far`` (a search bound) of free parameter ``j``, the
+    profile rising above the cost ``at_fit``; the 95 % search starts from the 68 % end (twice
+    its distance: the quadratic guess)."""
+    rise = rise_above(held_cost(obj, theta, j), at_fit)
     value = float(theta[j])
-    base = 0.5 * obj.cost(theta)
-
-    def rise(u: float) -> float:
-        return held(u) - base
-
     out: dict[str, float | None] = {}
     step = first
     for level, z in LEVELS.items():
@@ -127,26 +132,31 @@ def _side(obj: Objective, theta: np.ndarray, j: int, far: float, kappa: float,
     return out
 
 
-def add_profiles(result: FitResult, measurement: Measurement, options: FitOptions
-                 ) -> FitResult:
+def add_profiles(result: FitResult, measurement: Measurement, options: FitOptions, *,
+                 two_sided: bool = True) -> FitResult:
     """``result`` (of ``measurement`` fitted with ``options``, each channel on its own) with,
     when ``options.intervals == "profile"``, the one-sided limits of its parameters on a
-    physical limit (:func:`~roughbrdf.fitting.results.one_sided.add_one_sided`) and the profile
-    intervals of those with a standard error (:func:`profile_intervals`;
-    :attr:`ChannelFit.intervals <roughbrdf.fitting.results.result.ChannelFit.intervals>`);
-    unchanged otherwise."""
+    physical limit (:func:`~roughbrdf.fitting.results.one_sided.one_sided_limits`) and, with
+    ``two_sided``, the profile intervals of those with a standard error
+    (:func:`profile_intervals`; :attr:`ChannelFit.intervals
+    <roughbrdf.fitting.results.result.ChannelFit.intervals>`), one objective per channel for
+    both; unchanged otherwise."""
     if options.intervals != "profile":  # opt-in: a profile costs many refits (module notes)
         return result
-    add_one_sided(result, measurement, options)
     for c in result.channels:
         if c.energy_constraint is not None and c.energy_constraint.active:
             # the profile would have to hold the constraint (one_sided's notes): said, since
             # they were asked for
             c.message += NOT_UNDER_CONSTRAINT
             continue
-        names = _with_stderr(c)
-        obj = objective_of(c, measurement, options) if names else None
-        if obj is not None:
+        physical = any(k.startswith("physical") for k in c.limits.values())
+        names = _with_stderr(c) if two_sided else []
+        obj = objective_of(c, measurement, options) if physical or names else None
+        if obj is None:
+            continue
+        if physical:
+            c.one_sided = one_sided_limits(obj, c.params, c.limits)
+        if names:
             c.intervals = profile_intervals(obj, c.params, c.stderr, names)
     return result
 

@@ -25,7 +25,7 @@ limit") derives it; in short:
   range, the limit is ``None``: the data do not bound the parameter there.
 
 Opt-in: with ``intervals="profile"`` (``--intervals profile``) :func:`roughbrdf.fit` computes
-them (:func:`add_one_sided`, through :func:`~roughbrdf.fitting.results.intervals.add_profiles`,
+them (:func:`one_sided_limits`, through :func:`~roughbrdf.fitting.results.intervals.add_profiles`,
 which adds two-sided profile intervals of the other parameters from the same profile) for the
 fit it returns: a model's fit, or the one ``--model auto`` keeps, not the candidates nor the
 cross-validation folds; for channels fitted on their own and not under an active energy
@@ -60,10 +60,10 @@ from .statistics import Covariance
 if TYPE_CHECKING:
     from ...measurement import Measurement
     from ..problem.options import FitOptions
-    from .result import ChannelFit, FitResult
+    from .result import ChannelFit
 
-__all__ = ["LEVEL", "Z", "add_one_sided", "dispersion", "held_cost", "objective_of",
-           "one_sided_limits", "profile_limit"]
+__all__ = ["LEVEL", "Z", "calibration", "dispersion", "held_cost", "objective_of",
+           "one_sided_limits", "profile_limit", "rise_above"]
 
 #: the one-sided confidence level of the limits
 LEVEL = 0.95
@@ -81,10 +81,38 @@ RTOL = 0.01
 MAX_REFITS = 40
 
 
+def calibration(obj: Objective, theta: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per free parameter of ``obj`` at ``theta``, from one central-difference Jacobian: the
+    dispersion ``kappa = V_jj / (H^-1)_jj`` (module notes: the sandwich variance over the
+    curvature's, the scale's column included when it is free; NaN where ``H`` is singular),
+    and the profile's local slope ``|J_j . r|`` and curvature ``J_j . c J_j`` (the first
+    step's model, :func:`one_sided_limits`)."""
+    f = obj.values(theta)
+    k = obj.scale(f)
+    r = obj.residual_of(f, k)
+    curv = obj.curvature_of(f, k)
+    params = obj.jac_central(theta, k)
+    slope = np.abs(params.T @ r)
+    local = np.einsum("ij,ij->j", params, params * curv[:, None])
+    jac = params if not obj.spec.free_scale \
+        else np.hstack([params, obj.scale_column(f, k)[:, None]])
+    p = params.shape[1]
+    try:  # H^-1 and the sandwich V of statistics.Covariance, with every parameter free
+        inv = np.diag(Covariance.curvature_inverse(jac, curv))[:p]
+    except np.linalg.LinAlgError:
+        return np.full(p, math.nan), slope, local
+    cov = Covariance.from_jacobian(jac, [str(i) for i in range(jac.shape[1])],
+                                   chi2=math.nan, dof=r.size - jac.shape[1], residual=r,
+                                   curvature=curv)
+    var = np.diag(cov.matrix)[:p]
+    with np.errstate(invalid="ignore", divide="ignore"):  # a NaN V or H^-1 <= 0: NaN
+        kappa = np.where((inv > 0) & np.isfinite(var), var / inv, math.nan)
+    return kappa, slope, local
+
+
 def dispersion(obj: Objective, theta: np.ndarray, j: int) -> float:
-    """``kappa = V_jj / (H^-1)_jj`` at ``theta`` for free parameter ``j`` (module notes): the
-    sandwich variance over the curvature's, the scale's column included when it is free. NaN
-    where ``H`` is singular.
+    """``kappa`` of free parameter ``j`` (:func:`calibration`).
 
     Examples
     --------
@@ -96,23 +124,7 @@ def dispersion(obj: Objective, theta: np.ndarray, j: int) -> float:
     >>> round(dispersion(obj, np.array([0.2 * np.pi]), 0), 6)   # sum r^2 / (N - 1)
     0.006667
     """
-    f = obj.values(theta)
-    k = obj.scale(f)
-    r = obj.residual_of(f, k)
-    cols = [obj.jac_central(theta, k)]
-    if obj.spec.free_scale:
-        cols.append(obj.scale_column(f, k)[:, None])
-    jac = np.hstack(cols)
-    curv = obj.curvature_of(f, k)
-    try:  # H^-1 and the sandwich V of statistics.Covariance, with the parameter free
-        inv = Covariance.curvature_inverse(jac, curv)
-    except np.linalg.LinAlgError:
-        return math.nan
-    dof = r.size - jac.shape[1]
-    cov = Covariance.from_jacobian(jac, [str(i) for i in range(jac.shape[1])],
-                                   chi2=math.nan, dof=dof, residual=r, curvature=curv)
-    var = float(cov.matrix[j, j])
-    return var / float(inv[j, j]) if inv[j, j] > 0 and math.isfinite(var) else math.nan
+    return float(calibration(obj, theta)[0][j])
 
 
 def profile_limit(rise: Callable[[float], float], bound: float, far: float, threshold: float,
@@ -221,22 +233,16 @@ def held_cost(obj: Objective, theta: np.ndarray, j: int) -> Callable[[float], fl
     return cost
 
 
-def _rise(held: Callable[[float], float], base: float) -> Callable[[float], float]:
-    """The profile ``D(u) = held(u) - base``."""
+def rise_above(held: Callable[[float], float], base: float) -> Callable[[float], float]:
+    """The profile ``D(u) = held(u) - base`` (``held``: :func:`held_cost`; ``base``: the cost
+    at the fit)."""
     return lambda u: held(u) - base
 
 
-def _first_step(obj: Objective, theta: np.ndarray, j: int, threshold: float) -> float:
+def _first_step(width: float, slope: float, h: float, threshold: float) -> float:
     """A first distance from the limit: where the local model ``|g| d + h d^2 / 2`` of the
-    profile (its slope ``g`` at the limit, the curvature ``h = 1 / (H^-1)_jj``) reaches the
-    threshold; a twentieth of the search range where neither is known."""
-    spec = obj.spec
-    width = float(spec.upper[j] - spec.lower[j])
-    f = obj.values(theta)
-    k = obj.scale(f)
-    col = obj.jac_central(theta, k, columns=[j])[:, 0]
-    slope = abs(float(col @ obj.residual_of(f, k)))
-    h = float(col @ (col * obj.curvature_of(f, k)))
+    profile (its slope ``g`` at the limit, its curvature ``h``; :func:`calibration`) reaches the
+    threshold; a twentieth of the search range ``width`` where neither is known."""
     if h > 0 and math.isfinite(h):
         return (math.sqrt(slope * slope + 2.0 * h * threshold) - slope) / h
     return width / 20.0 if math.isfinite(width) else 1.0
@@ -264,38 +270,27 @@ def one_sided_limits(obj: Objective, params: Mapping[str, Any],
     """
     spec = obj.spec
     theta = np.array([float(params[nm]) for nm in spec.free])
+    names = [nm for nm, kind in limits.items() if kind.startswith("physical") and nm in spec.free]
+    if not names:
+        return {}
+    kappas, slopes, local = calibration(obj, theta)
+    at_fit = 0.5 * obj.cost(theta)
     out: dict[str, float | None] = {}
-    for name, kind in limits.items():
-        if not kind.startswith("physical") or name not in spec.free:
-            continue
+    for name in names:
         j = spec.free.index(name)
-        kappa = dispersion(obj, theta, j)
+        kappa = float(kappas[j])
         if not (math.isfinite(kappa) and kappa > 0):
             continue  # no calibration (a singular curvature): no limit claimed
         threshold = 0.5 * kappa * Z * Z
-        lower = kind.endswith("lower")
+        lower = limits[name].endswith("lower")
         bound, far = (spec.lower[j], spec.upper[j]) if lower else (spec.upper[j], spec.lower[j])
         held = held_cost(obj, theta, j)
-        base = min(0.5 * obj.cost(theta), held(float(bound)))
-        out[name] = profile_limit(_rise(held, base), float(bound), float(far), threshold,
-                                  _first_step(obj, theta, j, threshold))
+        base = min(at_fit, held(float(bound)))
+        first = _first_step(float(spec.upper[j] - spec.lower[j]), float(slopes[j]),
+                            float(local[j]), threshold)
+        out[name] = profile_limit(rise_above(held, base), float(bound), float(far), threshold,
+                                  first)
     return out
-
-
-def add_one_sided(result: FitResult, measurement: Measurement, options: FitOptions) -> FitResult:
-    """``result`` (of ``measurement`` fitted with ``options``, each channel on its own) with the
-    one-sided limits of its channels' parameters on a physical limit (:func:`one_sided_limits`,
-    :attr:`ChannelFit.one_sided <roughbrdf.fitting.results.result.ChannelFit.one_sided>`); a
-    channel fitted under an active energy constraint keeps none."""
-    for c in result.channels:
-        if not any(k.startswith("physical") for k in c.limits.values()):
-            continue
-        if c.energy_constraint is not None and c.energy_constraint.active:
-            continue  # the profile would have to hold the constraint too (module notes)
-        obj = objective_of(c, measurement, options)
-        if obj is not None:
-            c.one_sided = one_sided_limits(obj, c.params, c.limits)
-    return result
 
 
 def objective_of(c: ChannelFit, measurement: Measurement, options: FitOptions

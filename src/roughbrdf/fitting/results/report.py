@@ -208,14 +208,20 @@ def _physical_units(c: ChannelFit) -> dict[str, str]:
             if p.unit not in ("", "1", "rad")}
 
 
+def _shown(v: float | None, angle: str | None, digits: int = 6) -> str:
+    """``v`` (radians where ``angle`` names the unit of an angle parameter) in that unit,
+    :func:`fmt`-ed."""
+    if v is None or angle is None:
+        return fmt(v, digits)
+    return fmt(math.degrees(v) if angle == "deg" else v, digits)
+
+
 def _variable(c: ChannelFit, name: str, val: float | None, angle: str | None,
               physical: str | None = None) -> str:
     """One parameter's line; ``angle`` is the unit of an angle parameter (else None),
     ``physical`` another unit to print beside the values (else None)."""
     def shown(v: float | None, digits: int = 6) -> str:
-        if v is None or angle is None:
-            return fmt(v, digits)
-        return fmt(math.degrees(v) if angle == "deg" else v, digits)
+        return _shown(v, angle, digits)
 
     unit = f" {angle}" if angle else (f" {physical}" if physical else "")
     if name not in c.free:
@@ -274,17 +280,18 @@ def _profile_lines(c: ChannelFit, angles: str) -> list[str]:
     lines = ["[[Profile intervals]] (where the cost, the others refitted, rises as the standard "
              "errors calibrate it)"]
     for name, by in c.intervals.items():
-        deg = angles == "deg" and name in angular
-
-        def show(v: float | None, deg: bool = deg) -> str:
-            return "none" if v is None else fmt(math.degrees(v) if deg else v, 5)
-
-        unit = f" {angles}" if name in angular else ""
+        angle = angles if name in angular else None
+        unit = f" {angle}" if angle else ""
         lines.append(f"    {name:<{width}}: " + "  ".join(
-            f"{lv} % [{show(lo)}, {show(hi)}]{unit}" for lv, (lo, hi) in by.items()))
+            f"{lv} % [{_end(lo, angle)}, {_end(hi, angle)}]{unit}" for lv, (lo, hi) in by.items()))
     if any(v is None for by in c.intervals.values() for pair in by.values() for v in pair):
         lines.append("    (none: the data do not bound that side within the search range)")
     return lines
+
+
+def _end(v: float | None, angle: str | None) -> str:
+    """One end of a profile interval: ``none`` where the data do not bound that side."""
+    return "none" if v is None else _shown(v, angle, 5)
 
 
 def _correlations(c: ChannelFit, min_correl: float) -> list[str]:
